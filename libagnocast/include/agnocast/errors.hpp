@@ -1,0 +1,58 @@
+// The exception types the library throws, so callers can tell causes apart.
+#pragma once
+
+#include <new>
+#include <stdexcept>
+#include <string>
+
+namespace agnocast {
+
+// Base of every agnocast runtime failure that is not a bad argument or exhaustion.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// /dev/agnocast does not exist: the kernel module is not loaded.
+class ModuleNotLoaded : public Error {
+ public:
+  ModuleNotLoaded();
+};
+
+// The loaded module speaks another major.minor than this library.
+class VersionMismatch : public Error {
+ public:
+  using Error::Error;
+};
+
+// The device rejected a request; code() is the errno the kernel returned.
+class DeviceError : public Error {
+ public:
+  DeviceError(int code, const std::string& message) : Error(message), code_(code) {}
+  int code() const noexcept { return code_; }
+
+ private:
+  int code_;
+};
+
+// A POSIX message queue could not be created or opened (often a system limit).
+class QueueError : public Error {
+ public:
+  QueueError(int code, const std::string& message) : Error(message), code_(code) {}
+  int code() const noexcept { return code_; }
+
+ private:
+  int code_;
+};
+
+// The process's shared-memory pool has no room left even after reclaiming.
+class PoolExhausted : public std::bad_alloc {
+ public:
+  explicit PoolExhausted(std::string message) : message_(std::move(message)) {}
+  const char* what() const noexcept override { return message_.c_str(); }
+
+ private:
+  std::string message_;
+};
+
+}  // namespace agnocast

@@ -1,0 +1,72 @@
+// Read-only view of the kernel module's state for tools (agnocast-cli).
+// These functions open /dev/agnocast on their own, never register the calling
+// process, and throw ModuleNotLoaded when the module is absent.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "agnocast/version.hpp"
+
+namespace agnocast {
+
+struct TopicSummary {
+  std::string name;
+  std::uint32_t publishers = 0;
+  std::uint32_t subscribers = 0;
+};
+
+struct PublisherInfo {
+  std::uint32_t id = 0;
+  pid_t pid = 0;
+  std::string node;
+  std::uint32_t depth = 0;
+  bool transient_local = false;
+  std::uint64_t published = 0;
+  std::uint64_t published_bytes = 0;
+  std::uint32_t window = 0;  // entries currently in the publisher's depth window
+};
+
+struct SubscriberInfo {
+  std::uint32_t id = 0;
+  pid_t pid = 0;
+  std::string node;
+  std::uint32_t depth = 0;
+  bool transient_local = false;
+  bool polling = false;  // polling subscribers own no notification queue
+  std::uint32_t unreceived = 0;
+  std::uint32_t held = 0;
+  std::uint64_t received = 0;
+  std::uint64_t dropped = 0;
+};
+
+struct TopicInfo {
+  std::string name;
+  std::vector<PublisherInfo> publishers;
+  std::vector<SubscriberInfo> subscribers;
+  std::uint32_t entries = 0;  // live message entries of the topic
+};
+
+struct ProcessInfo {
+  pid_t pid = 0;
+  std::uint32_t publishers = 0;
+  std::uint32_t subscribers = 0;
+  std::uint32_t pools_mapped = 0;
+  std::uint64_t pool_addr = 0;
+  std::uint64_t pool_size = 0;
+};
+
+// True when /dev/agnocast exists.
+bool module_loaded();
+// The loaded module's version, nullopt when it is not loaded.
+std::optional<Version> module_version();
+std::vector<TopicSummary> list_topics();
+// nullopt when no topic of that name has an endpoint.
+std::optional<TopicInfo> topic_info(const std::string& topic);
+std::vector<ProcessInfo> list_processes();
+
+}  // namespace agnocast

@@ -1,0 +1,43 @@
+// Naming rules shared by the library, the daemon and the CLI: topic names and
+// the notification queue that belongs to each callback subscriber.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace agnocast {
+
+// Where the mqueue filesystem is mounted; a queue "/x@1" is the file "/dev/mqueue/x@1".
+inline constexpr std::string_view mqueue_directory = "/dev/mqueue";
+
+// Linux refuses queue names longer than NAME_MAX (after the leading '/').
+inline constexpr std::size_t queue_name_max = 255;
+// The longest decimal subscriber id (UINT32_MAX has 10 digits).
+inline constexpr std::size_t subscriber_id_digits_max = 10;
+// Longest topic name whose queue name fits NAME_MAX for every possible id:
+// topic (with its leading '/') - 1 + '@' + 10 digits <= 255.
+inline constexpr std::size_t topic_name_max = queue_name_max - subscriber_id_digits_max;
+
+// Empty when the name is valid, else a sentence naming the broken rule.
+std::string topic_name_problem(std::string_view topic);
+bool is_valid_topic_name(std::string_view topic);
+// Throws std::invalid_argument naming the rule the topic breaks.
+void validate_topic_name(std::string_view topic);
+
+// "/a/b/c" -> "/a_b_c": every '/' after the leading one becomes '_'.
+std::string mangle_topic_name(std::string_view topic);
+// "/a/b", 3 -> "/a_b@3", the name to pass to mq_open.
+std::string queue_name(std::string_view topic, std::uint32_t subscriber_id);
+
+struct QueueNameParts {
+  std::string mangled_topic;  // with its leading '/', e.g. "/a_b"
+  std::uint32_t subscriber_id = 0;
+};
+// Accepts "/a_b@3" (mq_open form) or "a_b@3" (a file name in mqueue_directory);
+// nullopt when it does not follow the agnocast pattern.
+std::optional<QueueNameParts> parse_queue_name(std::string_view name);
+
+}  // namespace agnocast

@@ -1,0 +1,392 @@
+#include "device.hpp"
+
+#include <agnocast.h>
+#include <fcntl.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <string_view>
+#include <utility>
+
+#include "agnocast/errors.hpp"
+
+namespace agnocast {
+
+ModuleNotLoaded::ModuleNotLoaded()
+    : Error("agnocast kernel module is not loaded (" AGNOCAST_DEVICE_PATH
+            " missing): run `systemctl start agnocastd`") {}
+
+}  // namespace agnocast
+
+namespace agnocast::detail {
+namespace {
+
+static_assert(AGNOCAST_VERSION_MAJOR == library_version.major &&
+                  AGNOCAST_VERSION_MINOR == library_version.minor,
+              "the UAPI header and the project version must agree on major.minor");
+static_assert(AGNOCAST_DEPTH_MAX == depth_max);
+static_assert(AGNOCAST_TOPIC_NAME_MAX > topic_name_max);
+
+std::string errno_advice(int err) {
+  switch (err) {
+    case ESRCH:
+      return "this process is not registered with the module";
+    case EXDEV:
+      return "this process moved to another IPC namespace after it started using agnocast; "
+             "create agnocast objects only after unshare/setns";
+    case ENOENT:
+      return "no such topic, endpoint or entry";
+    case EPERM:
+      return "the endpoint belongs to another process, or the operation needs CAP_SYS_ADMIN";
+    case EINVAL:
+      return "the module rejected an argument as invalid";
+    case ENOMEM:
+      return "the kernel is out of memory";
+    case ENOTTY:
+      return "the module does not know this command; are the module and library versions equal?";
+    case EFAULT:
+      return "an address is outside the memory the module accepts";
+    default:
+      return std::strerror(err);
+  }
+}
+
+[[noreturn]] void fail(std::string_view command, int err, std::string_view detail = {}) {
+  std::string message = "agnocast: ";
+  message += command;
+  message += " failed: ";
+  message += detail.empty() ? errno_advice(err) : std::string(detail);
+  message += " (";
+  message += std::strerror(err);
+  message += ")";
+  throw DeviceError(err, message);
+}
+
+// Retries on EINTR; returns 0 or the errno.
+int call(int fd, unsigned long request, void* argument) {
+  for (;;) {
+    if (::ioctl(fd, request, argument) == 0) return 0;
+    if (errno != EINTR) return errno;
+  }
+}
+
+void copy_name(char* destination, std::size_t capacity, const std::string& source,
+               std::string_view what) {
+  if (source.size() >= capacity) {
+    throw std::invalid_argument(std::string(what) + " is too long: at most " +
+                                std::to_string(capacity - 1) + " characters");
+  }
+  std::memcpy(destination, source.data(), source.size());
+  destination[source.size()] = '\0';
+}
+
+std::string bounded_string(const char* text, std::size_t capacity) {
+  return std::string(text, ::strnlen(text, capacity));
+}
+
+agnocast_add_endpoint make_endpoint_request(const EndpointRequest& request) {
+  agnocast_add_endpoint argument{};
+  copy_name(argument.topic, sizeof argument.topic, request.topic, "topic name");
+  copy_name(argument.node, sizeof argument.node, request.node, "node name");
+  argument.depth = request.depth;
+  argument.flags = (request.transient_local ? AGNOCAST_TRANSIENT_LOCAL : 0U) |
+                   (request.polling ? AGNOCAST_POLLING : 0U);
+  return argument;
+}
+
+std::string add_endpoint_advice(int err, const EndpointRequest& request, std::string_view kind) {
+  switch (err) {
+    case ENOSPC:
+      return "topic " + request.topic + " already has the maximum number of " + std::string(kind) +
+             "s, or the IPC namespace has too many topics";
+    case EINVAL:
+      return "the module refused topic '" + request.topic + "', node '" + request.node +
+             "' or depth " + std::to_string(request.depth) + " (1.." + std::to_string(depth_max) +
+             ")";
+    default:
+      return {};
+  }
+}
+
+}  // namespace
+
+Device Device::open(bool nonblocking) {
+  const int extra = O_CLOEXEC | (nonblocking ? O_NONBLOCK : 0);
+  int fd = ::open(AGNOCAST_DEVICE_PATH, O_RDWR | extra);
+  if (fd < 0 && errno == EACCES) fd = ::open(AGNOCAST_DEVICE_PATH, O_RDONLY | extra);
+  if (fd < 0) {
+    const int err = errno;
+    if (err == ENOENT || err == ENXIO || err == ENODEV) throw ModuleNotLoaded();
+    fail("open " AGNOCAST_DEVICE_PATH, err,
+         err == EACCES ? "permission denied; check the device's mode (agnocastd sets it)"
+                       : std::string_view{});
+  }
+  return Device(fd);
+}
+
+Device::Device(Device&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+
+Device& Device::operator=(Device&& other) noexcept {
+  if (this != &other) {
+    close();
+    fd_ = std::exchange(other.fd_, -1);
+  }
+  return *this;
+}
+
+Device::~Device() { close(); }
+
+void Device::close() {
+  if (fd_ >= 0) ::close(std::exchange(fd_, -1));
+}
+
+Version Device::get_version() const {
+  agnocast_version argument{};
+  if (int err = call(fd_, AGNOCAST_IOC_GET_VERSION, &argument)) fail("GET_VERSION", err);
+  return Version{argument.major, argument.minor, argument.patch};
+}
+
+PoolSlot Device::register_process(int pool_fd) const {
+  agnocast_register_process argument{};
+  argument.pool_fd = pool_fd;
+  if (int err = call(fd_, AGNOCAST_IOC_REGISTER_PROCESS, &argument)) {
+    switch (err) {
+      case ENOSPC:
+        fail("REGISTER_PROCESS", err,
+             "every agnocast pool slot is in use; raise the module parameter pool_count "
+             "(modprobe agnocast pool_count=N, or the agnocastd configuration)");
+      case EBUSY:
+        fail("REGISTER_PROCESS", err, "this process's pool is already attached");
+      default:
+        fail("REGISTER_PROCESS", err);
+    }
+  }
+  return PoolSlot{argument.pid, argument.pool_addr, argument.pool_size};
+}
+
+void Device::unregister_process() const {
+  if (int err = call(fd_, AGNOCAST_IOC_UNREGISTER_PROCESS, nullptr)) {
+    fail("UNREGISTER_PROCESS", err);
+  }
+}
+
+EndpointId Device::add_publisher(const EndpointRequest& request) const {
+  agnocast_add_endpoint argument = make_endpoint_request(request);
+  if (int err = call(fd_, AGNOCAST_IOC_ADD_PUBLISHER, &argument)) {
+    fail("ADD_PUBLISHER", err, add_endpoint_advice(err, request, "publisher"));
+  }
+  return EndpointId{argument.topic_handle, argument.id};
+}
+
+EndpointId Device::add_subscriber(const EndpointRequest& request) const {
+  agnocast_add_endpoint argument = make_endpoint_request(request);
+  if (int err = call(fd_, AGNOCAST_IOC_ADD_SUBSCRIBER, &argument)) {
+    fail("ADD_SUBSCRIBER", err, add_endpoint_advice(err, request, "subscriber"));
+  }
+  return EndpointId{argument.topic_handle, argument.id};
+}
+
+void Device::remove_publisher(EndpointId endpoint) const {
+  agnocast_remove_endpoint argument{endpoint.topic_handle, endpoint.id};
+  if (int err = call(fd_, AGNOCAST_IOC_REMOVE_PUBLISHER, &argument)) {
+    fail("REMOVE_PUBLISHER", err);
+  }
+}
+
+void Device::remove_subscriber(EndpointId endpoint) const {
+  agnocast_remove_endpoint argument{endpoint.topic_handle, endpoint.id};
+  if (int err = call(fd_, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &argument)) {
+    fail("REMOVE_SUBSCRIBER", err);
+  }
+}
+
+PublishResult Device::publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
+                              std::span<std::uint32_t> wake_ids,
+                              std::span<std::uint64_t> reclaim) const {
+  agnocast_publish argument{};
+  argument.topic_handle = publisher.topic_handle;
+  argument.publisher_id = publisher.id;
+  argument.addr = addr;
+  argument.bytes = bytes;
+  argument.wake_ids = reinterpret_cast<std::uintptr_t>(wake_ids.data());
+  argument.wake_capacity = static_cast<std::uint32_t>(wake_ids.size());
+  argument.reclaim = reinterpret_cast<std::uintptr_t>(reclaim.data());
+  argument.reclaim_capacity = static_cast<std::uint32_t>(reclaim.size());
+  // ENOBUFS is for the caller to handle (grow wake_ids and retry), so it is thrown plainly.
+  if (int err = call(fd_, AGNOCAST_IOC_PUBLISH, &argument)) {
+    fail("PUBLISH", err,
+         err == ENOBUFS ? "more subscribers than wake-up slots" : std::string_view{});
+  }
+  return PublishResult{argument.entry_id, argument.wake_count, argument.reclaim_count,
+                       argument.reclaim_pending};
+}
+
+ReclaimResult Device::reclaim(std::span<std::uint64_t> reclaim) const {
+  agnocast_reclaim argument{};
+  argument.reclaim = reinterpret_cast<std::uintptr_t>(reclaim.data());
+  argument.reclaim_capacity = static_cast<std::uint32_t>(reclaim.size());
+  if (int err = call(fd_, AGNOCAST_IOC_RECLAIM, &argument)) fail("RECLAIM", err);
+  return ReclaimResult{argument.reclaim_count, argument.reclaim_pending};
+}
+
+ReceiveResult Device::receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
+                              std::span<PoolGrant> pools) const {
+  std::vector<agnocast_entry> raw_entries(entries.size());
+  std::vector<agnocast_pool> raw_pools(pools.size());
+  agnocast_receive argument{};
+  argument.topic_handle = subscriber.topic_handle;
+  argument.subscriber_id = subscriber.id;
+  argument.entries = reinterpret_cast<std::uintptr_t>(raw_entries.data());
+  argument.entry_capacity = static_cast<std::uint32_t>(raw_entries.size());
+  argument.pools = reinterpret_cast<std::uintptr_t>(raw_pools.data());
+  argument.pool_capacity = static_cast<std::uint32_t>(raw_pools.size());
+  if (int err = call(fd_, AGNOCAST_IOC_RECEIVE, &argument)) fail("RECEIVE", err);
+  for (std::uint32_t i = 0; i < argument.entry_count; ++i) {
+    entries[i] =
+        ReceivedEntry{raw_entries[i].entry_id, raw_entries[i].addr, raw_entries[i].publisher_id};
+  }
+  for (std::uint32_t i = 0; i < argument.pool_count; ++i) {
+    pools[i] = PoolGrant{raw_pools[i].addr, raw_pools[i].size, raw_pools[i].fd, raw_pools[i].pid};
+  }
+  return ReceiveResult{argument.entry_count, argument.pool_count, argument.remaining};
+}
+
+TakeResult Device::take(EndpointId subscriber) const {
+  agnocast_take argument{};
+  argument.topic_handle = subscriber.topic_handle;
+  argument.subscriber_id = subscriber.id;
+  if (int err = call(fd_, AGNOCAST_IOC_TAKE, &argument)) fail("TAKE", err);
+  TakeResult result;
+  result.has_entry = argument.entry_count == 1;
+  result.entry =
+      ReceivedEntry{argument.entry.entry_id, argument.entry.addr, argument.entry.publisher_id};
+  result.has_pool = argument.pool_count == 1;
+  if (result.has_pool) {
+    result.pool =
+        PoolGrant{argument.pool.addr, argument.pool.size, argument.pool.fd, argument.pool.pid};
+  }
+  return result;
+}
+
+void Device::release(EndpointId subscriber, std::uint64_t entry_id) const {
+  agnocast_release argument{};
+  argument.topic_handle = subscriber.topic_handle;
+  argument.subscriber_id = subscriber.id;
+  argument.entry_id = entry_id;
+  if (int err = call(fd_, AGNOCAST_IOC_RELEASE, &argument)) fail("RELEASE", err);
+}
+
+std::vector<TopicSummary> Device::list_topics() const {
+  // The list may grow between the count and the fetch: retry until it fits.
+  std::vector<agnocast_topic_summary> raw(16);
+  agnocast_list_topics argument{};
+  for (;;) {
+    argument = {};
+    argument.topics = reinterpret_cast<std::uintptr_t>(raw.data());
+    argument.capacity = static_cast<std::uint32_t>(raw.size());
+    if (int err = call(fd_, AGNOCAST_IOC_LIST_TOPICS, &argument)) fail("LIST_TOPICS", err);
+    if (argument.total <= raw.size()) break;
+    raw.resize(argument.total + 16);
+  }
+  std::vector<TopicSummary> topics;
+  for (std::uint32_t i = 0; i < argument.total; ++i) {
+    topics.push_back(
+        {bounded_string(raw[i].name, sizeof raw[i].name), raw[i].publishers, raw[i].subscribers});
+  }
+  return topics;
+}
+
+bool Device::topic_info(const std::string& topic, TopicInfo& info) const {
+  std::vector<agnocast_publisher_info> publishers(8);
+  std::vector<agnocast_subscriber_info> subscribers(8);
+  agnocast_topic_info argument{};
+  for (;;) {
+    argument = {};
+    copy_name(argument.name, sizeof argument.name, topic, "topic name");
+    argument.publishers = reinterpret_cast<std::uintptr_t>(publishers.data());
+    argument.publisher_capacity = static_cast<std::uint32_t>(publishers.size());
+    argument.subscribers = reinterpret_cast<std::uintptr_t>(subscribers.data());
+    argument.subscriber_capacity = static_cast<std::uint32_t>(subscribers.size());
+    if (int err = call(fd_, AGNOCAST_IOC_TOPIC_INFO, &argument)) {
+      if (err == ENOENT) return false;
+      fail("TOPIC_INFO", err);
+    }
+    if (argument.publisher_total <= publishers.size() &&
+        argument.subscriber_total <= subscribers.size()) {
+      break;
+    }
+    publishers.resize(argument.publisher_total + 8);
+    subscribers.resize(argument.subscriber_total + 8);
+  }
+  info = TopicInfo{};
+  info.name = topic;
+  info.entries = argument.entries;
+  for (std::uint32_t i = 0; i < argument.publisher_total; ++i) {
+    const auto& raw = publishers[i];
+    info.publishers.push_back(PublisherInfo{raw.id, raw.pid,
+                                            bounded_string(raw.node, sizeof raw.node), raw.depth,
+                                            (raw.flags & AGNOCAST_TRANSIENT_LOCAL) != 0,
+                                            raw.published, raw.published_bytes, raw.window});
+  }
+  for (std::uint32_t i = 0; i < argument.subscriber_total; ++i) {
+    const auto& raw = subscribers[i];
+    info.subscribers.push_back(SubscriberInfo{
+        raw.id, raw.pid, bounded_string(raw.node, sizeof raw.node), raw.depth,
+        (raw.flags & AGNOCAST_TRANSIENT_LOCAL) != 0, (raw.flags & AGNOCAST_POLLING) != 0,
+        raw.unreceived, raw.held, raw.received, raw.dropped});
+  }
+  return true;
+}
+
+std::vector<ProcessInfo> Device::list_processes() const {
+  std::vector<agnocast_process_info> raw(16);
+  agnocast_list_processes argument{};
+  for (;;) {
+    argument = {};
+    argument.processes = reinterpret_cast<std::uintptr_t>(raw.data());
+    argument.capacity = static_cast<std::uint32_t>(raw.size());
+    if (int err = call(fd_, AGNOCAST_IOC_LIST_PROCESSES, &argument)) {
+      fail("LIST_PROCESSES", err);
+    }
+    if (argument.total <= raw.size()) break;
+    raw.resize(argument.total + 16);
+  }
+  std::vector<ProcessInfo> processes;
+  for (std::uint32_t i = 0; i < argument.total; ++i) {
+    processes.push_back(ProcessInfo{raw[i].pid, raw[i].publishers, raw[i].subscribers,
+                                    raw[i].pools_mapped, raw[i].pool_addr, raw[i].pool_size});
+  }
+  return processes;
+}
+
+std::vector<ExitRecord> Device::read_exit_records() const {
+  std::vector<ExitRecord> records;
+  agnocast_exit_record raw[32];
+  for (;;) {
+    const ssize_t got = ::read(fd_, raw, sizeof raw);
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      if (errno == EAGAIN) break;
+      const int err = errno;
+      fail("read exit records", err,
+           err == EPERM ? "reading exit records needs CAP_SYS_ADMIN (run as root, as agnocastd)"
+                        : std::string_view{});
+    }
+    const std::size_t count = static_cast<std::size_t>(got) / sizeof raw[0];
+    for (std::size_t i = 0; i < count; ++i) {
+      ExitRecord record;
+      record.kind =
+          raw[i].kind == AGNOCAST_EXIT_QUEUE ? ExitRecord::Kind::queue : ExitRecord::Kind::process;
+      record.pid = raw[i].pid;
+      record.subscriber_id = raw[i].subscriber_id;
+      record.topic = bounded_string(raw[i].topic, sizeof raw[i].topic);
+      records.push_back(std::move(record));
+    }
+    if (count < std::size(raw)) break;
+  }
+  return records;
+}
+
+}  // namespace agnocast::detail

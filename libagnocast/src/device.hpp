@@ -1,0 +1,129 @@
+// C++ wrapper over /dev/agnocast: one member per ioctl, errno turned into typed
+// exceptions. The only part of the library that knows the UAPI structures.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "agnocast/inspect.hpp"
+#include "agnocast/supervise.hpp"
+#include "agnocast/version.hpp"
+
+namespace agnocast::detail {
+
+inline constexpr std::uint32_t depth_max = 1024;
+
+struct PoolSlot {
+  pid_t pid = 0;
+  std::uint64_t addr = 0;
+  std::uint64_t size = 0;
+};
+
+struct EndpointId {
+  std::uint32_t topic_handle = 0;
+  std::uint32_t id = 0;
+};
+
+struct EndpointRequest {
+  std::string topic;
+  std::string node;
+  std::uint32_t depth = 1;
+  bool transient_local = false;
+  bool polling = false;
+};
+
+struct PublishResult {
+  std::uint64_t entry_id = 0;
+  std::uint32_t wake_count = 0;
+  std::uint32_t reclaim_count = 0;
+  std::uint32_t reclaim_pending = 0;
+};
+
+struct ReclaimResult {
+  std::uint32_t reclaim_count = 0;
+  std::uint32_t reclaim_pending = 0;
+};
+
+struct ReceivedEntry {
+  std::uint64_t entry_id = 0;
+  std::uint64_t addr = 0;
+  std::uint32_t publisher_id = 0;
+};
+
+// A read-only descriptor of a publisher's pool, owned by the receiver.
+struct PoolGrant {
+  std::uint64_t addr = 0;
+  std::uint64_t size = 0;
+  int fd = -1;
+  pid_t pid = 0;
+};
+
+struct ReceiveResult {
+  std::uint32_t entry_count = 0;
+  std::uint32_t pool_count = 0;
+  std::uint32_t remaining = 0;
+};
+
+struct TakeResult {
+  bool has_entry = false;
+  ReceivedEntry entry;
+  bool has_pool = false;
+  PoolGrant pool;
+};
+
+class Device {
+ public:
+  // Opens /dev/agnocast O_CLOEXEC; read-write when permitted, else read-only
+  // (enough for introspection). Throws ModuleNotLoaded when it is missing.
+  static Device open(bool nonblocking = false);
+
+  explicit Device(int fd) : fd_(fd) {}
+  Device(Device&& other) noexcept;
+  Device& operator=(Device&& other) noexcept;
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+  ~Device();
+
+  int fd() const { return fd_; }
+  // Closes the descriptor (fork child reset); the object becomes empty.
+  void close();
+  // Gives up ownership of the descriptor without closing it.
+  int release() { return std::exchange(fd_, -1); }
+
+  Version get_version() const;
+  // pool_fd -1 reserves a slot; a memfd of the slot's size attaches it.
+  PoolSlot register_process(int pool_fd) const;
+  void unregister_process() const;
+
+  EndpointId add_publisher(const EndpointRequest& request) const;
+  EndpointId add_subscriber(const EndpointRequest& request) const;
+  void remove_publisher(EndpointId endpoint) const;
+  void remove_subscriber(EndpointId endpoint) const;
+
+  PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
+                        std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim) const;
+  ReclaimResult reclaim(std::span<std::uint64_t> reclaim) const;
+  ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
+                        std::span<PoolGrant> pools) const;
+  TakeResult take(EndpointId subscriber) const;
+  void release(EndpointId subscriber, std::uint64_t entry_id) const;
+
+  std::vector<TopicSummary> list_topics() const;
+  // Returns false when no topic of that name has an endpoint.
+  bool topic_info(const std::string& topic, TopicInfo& info) const;
+  std::vector<ProcessInfo> list_processes() const;
+
+  // Whole exit records waiting now (device opened non-blocking); empty if none.
+  std::vector<ExitRecord> read_exit_records() const;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace agnocast::detail

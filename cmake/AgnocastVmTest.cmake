@@ -1,0 +1,51 @@
+# In-VM tests: each component registers its kernel-side and end-to-end tests
+# here; tests/CMakeLists.txt turns them into one VM boot and one ctest result
+# per test (vm.<NAME>).
+#
+#   agnocast_add_vm_test(NAME name COMMAND program [args...]
+#                        [TIMEOUT seconds] [TARGETS target...] [FILES path...])
+#
+# COMMAND's program is a target (its binary is copied into the VM) or a file
+# path (copied too); either is run by its file name from /opt/agnocast/bin,
+# which is on PATH.  TARGETS and FILES are further programs or data the test
+# needs, copied to the same place with every shared library they link.
+# The VM runs each test as root in a fresh /tmp/<NAME> working directory with
+# agnocast.ko loaded (its path is $AGNOCAST_MODULE), one after another;
+# TIMEOUT (default 120 s) bounds one test.
+function(agnocast_add_vm_test)
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES")
+  if(NOT arg_NAME OR NOT arg_COMMAND)
+    message(FATAL_ERROR "agnocast_add_vm_test needs NAME and COMMAND")
+  endif()
+  if(NOT arg_NAME MATCHES "^[A-Za-z0-9_.-]+$")
+    message(FATAL_ERROR "agnocast_add_vm_test: NAME '${arg_NAME}' may use only [A-Za-z0-9_.-]")
+  endif()
+  if(NOT arg_TIMEOUT)
+    set(arg_TIMEOUT 120)
+  endif()
+
+  list(POP_FRONT arg_COMMAND program)
+  set(files)
+  foreach(item IN LISTS program arg_TARGETS arg_FILES)
+    if(TARGET ${item})
+      list(APPEND files "$<TARGET_FILE:${item}>")
+    else()
+      get_filename_component(item "${item}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+      list(APPEND files "${item}")
+    endif()
+  endforeach()
+  if(TARGET ${program})
+    set(program_name "$<TARGET_FILE_NAME:${program}>")
+  else()
+    get_filename_component(program_name "${program}" NAME)
+  endif()
+
+  string(JOIN " " args ${arg_COMMAND})
+  set(lines)
+  foreach(file IN LISTS files)
+    string(APPEND lines "file\t${file}\n")
+  endforeach()
+  string(APPEND lines "test\t${arg_NAME}\t${arg_TIMEOUT}\t${program_name} ${args}\n")
+  set_property(GLOBAL APPEND_STRING PROPERTY AGNOCAST_VM_MANIFEST "${lines}")
+  set_property(GLOBAL APPEND PROPERTY AGNOCAST_VM_TEST_NAMES "${arg_NAME}")
+endfunction()

@@ -1,0 +1,236 @@
+/* SPDX-License-Identifier: GPL-2.0 */
+/*
+ * agnocast: state shared between the module's files.
+ *
+ * Locking overview (outermost first; see agnocast_ns.c):
+ *   1. agnocast_ns_list_lock  (mutex)    the list of namespace states
+ *   2. agnocast_ns.lock       (mutex)    everything inside one namespace
+ *   3. agnocast_proc_table_lock (spinlock) tgid -> process lookup; also taken
+ *                                        from the process-exit tracepoint
+ * receive_fd() and copy_{to,from}_user() may sleep: they run under 2 at most,
+ * never under 3.
+ */
+#ifndef _AGNOCAST_INTERNAL_H
+#define _AGNOCAST_INTERNAL_H
+
+#include <linux/hashtable.h>
+#include <linux/idr.h>
+#include <linux/list.h>
+#include <linux/mutex.h>
+#include <linux/types.h>
+#include <linux/wait.h>
+#include <linux/workqueue.h>
+
+#include "agnocast.h"
+
+/* A namespace holds at most this many topics (-ENOSPC beyond). */
+#define AGNOCAST_TOPICS_PER_NS_MAX 4096
+/* Unreferenced id spaces kept so that topic_local_ids are not reused soon. */
+#define AGNOCAST_DORMANT_ID_SPACES_MAX 1024
+
+struct ipc_namespace;
+struct pid;
+
+extern unsigned long agnocast_pool_size;
+extern unsigned int agnocast_pool_count;
+extern unsigned long agnocast_pool_base;
+
+/* State of one IPC namespace. */
+struct agnocast_ns {
+	struct list_head list_node;	/* protected by agnocast_ns_list_lock */
+	/* Users: open files, in-flight calls, teardown work.  Reaches 0 only
+	 * under agnocast_ns_list_lock, and only then may the state be freed.
+	 */
+	atomic_t users;
+	struct ipc_namespace *ipc_ns;	/* key only: no reference is held */
+	unsigned int ipc_inum;		/* with ipc_ns, guards against reuse */
+
+	struct mutex lock;
+	/* Everything below is protected by @lock. */
+	unsigned long *slot_map;	/* pool_count bits: slot in use */
+	struct agnocast_mempool **slots;	/* pool_count entries */
+	struct list_head procs;
+	unsigned int nr_procs;
+	DECLARE_HASHTABLE(topics, 8);
+	struct idr topic_handles;
+	unsigned int nr_topics;
+	DECLARE_HASHTABLE(id_spaces, 8);
+	struct list_head dormant_id_spaces; /* oldest first */
+	unsigned int nr_dormant_id_spaces;
+	struct list_head exit_records;	/* oldest first */
+	unsigned int nr_exit_records;	/* read without @lock by poll */
+	wait_queue_head_t exit_wait;
+};
+
+/* A publisher's shared-memory pool, occupying one slot. */
+struct agnocast_mempool {
+	/* All fields protected by the namespace lock. */
+	unsigned int slot;
+	u64 addr;
+	u64 size;
+	struct file *file;		/* read-only reopening; NULL until attached */
+	struct agnocast_proc *owner;	/* NULL once the owner is gone */
+	struct pid *owner_pid;
+	unsigned int mappers;		/* live processes given @file */
+	unsigned long entries;		/* live entries inside the pool */
+};
+
+/* A registered process. */
+struct agnocast_proc {
+	struct hlist_node table_node;	/* protected by agnocast_proc_table_lock */
+	bool dying;			/* protected by agnocast_proc_table_lock */
+	pid_t tgid;			/* init-namespace number; the table key */
+	u64 exec_id;
+	struct pid *pid;
+	struct agnocast_ns *ns;
+	struct work_struct teardown_work;
+
+	/* Protected by ns->lock. */
+	struct list_head ns_node;
+	struct agnocast_mempool *pool;
+	struct list_head publishers;
+	struct list_head subscribers;
+	unsigned int nr_publishers;
+	unsigned int nr_subscribers;
+	unsigned long *given;		/* pool_count bits: pools handed over */
+	unsigned int nr_given;
+	struct list_head reclaim;	/* freed entries of this process's pool */
+	unsigned int nr_reclaim;
+};
+
+/* Names equal after mangling share one topic_local_id counter. */
+struct agnocast_id_space {
+	struct hlist_node hash_node;
+	struct list_head dormant_node;	/* on ns->dormant_id_spaces iff !topics */
+	unsigned int topics;
+	u32 next_id;
+	char mangled[AGNOCAST_TOPIC_NAME_MAX];
+};
+
+struct agnocast_topic {
+	struct hlist_node hash_node;
+	struct agnocast_ns *ns;
+	struct agnocast_id_space *ids;
+	u32 handle;
+	struct list_head publishers;	/* by id */
+	struct list_head subscribers;	/* by id */
+	unsigned int nr_publishers;
+	unsigned int nr_subscribers;
+	unsigned int nr_callback_subscribers;
+	struct list_head entries;	/* by id */
+	unsigned int nr_entries;
+	u64 next_entry_id;
+	char name[AGNOCAST_TOPIC_NAME_MAX];
+};
+
+struct agnocast_publisher {
+	struct list_head topic_node;
+	struct list_head proc_node;
+	struct agnocast_topic *topic;
+	struct agnocast_proc *proc;
+	u32 id;
+	u32 depth;
+	u32 flags;
+	struct list_head window;	/* oldest first */
+	u32 window_len;
+	u64 published;
+	u64 published_bytes;
+	char node[AGNOCAST_NODE_NAME_MAX];
+};
+
+struct agnocast_subscriber {
+	struct list_head topic_node;
+	struct list_head proc_node;
+	struct agnocast_topic *topic;
+	struct agnocast_proc *proc;
+	u32 id;
+	u32 depth;
+	u32 flags;
+	/* Ring of depth unreceived entries, oldest at @head. */
+	struct agnocast_msg **unreceived;
+	u32 head;
+	u32 nr_unreceived;
+	struct list_head held;		/* of struct agnocast_held */
+	u32 nr_held;
+	u64 received;
+	u64 dropped;
+	char node[AGNOCAST_NODE_NAME_MAX];
+};
+
+struct agnocast_msg {
+	/* On topic->entries while live, on the owner's reclaim list after. */
+	struct list_head node;
+	struct list_head window_node;	/* valid while @publisher is set */
+	struct agnocast_topic *topic;
+	struct agnocast_publisher *publisher; /* NULL once out of the window */
+	struct agnocast_mempool *pool;
+	u64 id;
+	u64 addr;
+	u32 publisher_id;
+	/* One while in the window, plus one per subscriber reference. */
+	unsigned int refs;
+};
+
+struct agnocast_held {
+	struct list_head node;
+	struct agnocast_msg *entry;
+};
+
+/* The calling process's view, valid between agnocast_enter/agnocast_leave. */
+struct agnocast_ctx {
+	struct agnocast_ns *ns;
+	struct agnocast_proc *proc;	/* NULL if not registered */
+};
+
+/* agnocast_ns.c */
+int agnocast_ns_key_matches(const struct agnocast_ns *ns);
+struct agnocast_ns *agnocast_ns_get_current(void);
+void agnocast_ns_get(struct agnocast_ns *ns);
+void agnocast_ns_put(struct agnocast_ns *ns);
+void agnocast_ns_exit(void);
+
+/* agnocast_process.c */
+int agnocast_enter(struct agnocast_ctx *ctx, bool registered);
+void agnocast_leave(struct agnocast_ctx *ctx);
+int agnocast_process_init(void);
+void agnocast_process_exit(void);
+void agnocast_exit_records_free(struct agnocast_ns *ns);
+int agnocast_register_process(void __user *uarg);
+int agnocast_unregister_process(void);
+ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
+				   size_t count, bool nonblock);
+
+/* agnocast_pool.c */
+struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
+					    struct agnocast_proc *owner);
+int agnocast_pool_attach(struct agnocast_mempool *pool, int fd);
+void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool);
+bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
+				const struct agnocast_mempool *pool);
+int agnocast_pool_give(struct agnocast_proc *proc, struct agnocast_mempool *pool,
+		       struct agnocast_pool *out);
+void agnocast_pool_mark_given(struct agnocast_proc *proc, struct agnocast_mempool *pool);
+void agnocast_pool_drop_given(struct agnocast_proc *proc);
+
+/* agnocast_topic.c */
+void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
+void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
+void agnocast_id_spaces_free(struct agnocast_ns *ns);
+int agnocast_add_publisher(void __user *uarg);
+int agnocast_add_subscriber(void __user *uarg);
+int agnocast_remove_publisher(void __user *uarg);
+int agnocast_remove_subscriber(void __user *uarg);
+int agnocast_publish(void __user *uarg);
+int agnocast_reclaim(void __user *uarg);
+int agnocast_receive(void __user *uarg);
+int agnocast_take(void __user *uarg);
+int agnocast_release(void __user *uarg);
+bool agnocast_topic_name_valid(const char *name);
+struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
+
+/* agnocast_introspect.c */
+int agnocast_list_topics(void __user *uarg);
+int agnocast_topic_info(void __user *uarg);
+int agnocast_list_processes(void __user *uarg);
+
+#endif /* _AGNOCAST_INTERNAL_H */

@@ -1,0 +1,379 @@
+/* SPDX-License-Identifier: GPL-2.0 WITH Linux-syscall-note */
+/*
+ * agnocast: the one interface between agnocast.ko and user space.
+ *
+ * Everything here is fixed-width; user pointers travel as __u64; every
+ * reserved or padding field must be zero on input (-EINVAL otherwise) and is
+ * zero on output.  Strings are NUL-terminated inside their array; a missing
+ * terminator is -EINVAL.
+ *
+ * Errors common to every command:
+ *   -EFAULT  an argument or a buffer it names is not accessible
+ *   -EINVAL  nonzero padding/reserved field, unknown flag, bad string
+ *   -ENOTTY  unknown command
+ *   -ENOMEM  the kernel could not allocate bookkeeping memory
+ * Commands acting on endpoints or entries additionally return:
+ *   -ESRCH   the calling process is not registered (REGISTER_PROCESS first)
+ *   -EXDEV   the caller moved to another IPC namespace since registering
+ *   -ENOENT  no such topic handle, endpoint id or entry
+ *   -EPERM   the endpoint belongs to another process
+ *
+ * Processes are identified by their thread-group id.  A process that dies
+ * (any signal, any thread count) or execs loses every endpoint and reference
+ * it held; an exit record is queued for the daemon (see read() below).
+ *
+ * State is per IPC namespace: topics, ids and exit records of one namespace
+ * are invisible from another.
+ */
+#ifndef _UAPI_LINUX_AGNOCAST_H
+#define _UAPI_LINUX_AGNOCAST_H
+
+#include <linux/ioctl.h>
+#include <linux/types.h>
+
+#define AGNOCAST_DEVICE_PATH "/dev/agnocast"
+
+/* The module and the library must agree on major and minor. */
+#define AGNOCAST_VERSION_MAJOR 0
+#define AGNOCAST_VERSION_MINOR 1
+#define AGNOCAST_VERSION_PATCH 0
+
+/* Including the terminating NUL. */
+#define AGNOCAST_TOPIC_NAME_MAX 256
+#define AGNOCAST_NODE_NAME_MAX 128
+
+#define AGNOCAST_DEPTH_MAX 1024
+#define AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX 1024
+#define AGNOCAST_PUBLISHERS_PER_TOPIC_MAX 1024
+
+/* Endpoint flags (add_publisher / add_subscriber). */
+#define AGNOCAST_TRANSIENT_LOCAL (1U << 0)
+/* Subscriber only: woken by nobody, reads with TAKE instead of RECEIVE. */
+#define AGNOCAST_POLLING (1U << 1)
+
+/*
+ * AGNOCAST_IOC_GET_VERSION: never fails but for -EFAULT.
+ */
+struct agnocast_version {
+	__u32 major;
+	__u32 minor;
+	__u32 patch;
+	__u32 reserved;
+};
+
+/*
+ * AGNOCAST_IOC_REGISTER_PROCESS: make the caller a participant.
+ *
+ * Registration is two-step.  First pool_fd = -1: the kernel reserves a slot
+ * and reports pool_addr and pool_size, the same virtual range in every
+ * process of the namespace, and pid, the caller's pid as it sees itself.
+ * The caller then maps a memfd (tmpfs) of pool_size bytes writable at
+ * pool_addr and calls again with pool_fd set to attach it.  The kernel keeps
+ * its own read-only reopening of the file and hands that to subscribers, so
+ * no subscriber can ever map the pool writable.  Repeating the first step
+ * returns the same slot.
+ *
+ *   -EBUSY   pool already attached
+ *   -ENOSPC  every pool slot is in use (module parameter pool_count)
+ *   -EBADF   pool_fd is not an open descriptor
+ *   -EINVAL  pool_fd is not a tmpfs file, or smaller than pool_size
+ */
+struct agnocast_register_process {
+	__s32 pool_fd;
+	__s32 pid;
+	__u64 pool_addr;
+	__u64 pool_size;
+};
+
+/*
+ * AGNOCAST_IOC_UNREGISTER_PROCESS (no argument): drop every endpoint and
+ * reference of the caller and free its slot, as if it had exited, but queue
+ * no exit record.  -ESRCH if not registered.
+ */
+
+/*
+ * AGNOCAST_IOC_ADD_PUBLISHER, AGNOCAST_IOC_ADD_SUBSCRIBER
+ *
+ * in:  topic name (starts with '/', [A-Za-z0-9_/], no "//", no trailing '/'),
+ *      node label (printable ASCII, may be empty), depth 1..DEPTH_MAX, flags.
+ * out: topic_handle (valid until the topic has no endpoints and no entries)
+ *      and id, the topic_local_id.  Ids are never reused among topics whose
+ *      names are equal once every '/' after the first is mapped to '_', so
+ *      that their notification queue names never collide.
+ *
+ * A subscriber with AGNOCAST_TRANSIENT_LOCAL joining a topic receives, as its
+ * first unreceived entries, up to depth of the newest entries still in the
+ * window of publishers that are transient-local too.
+ *
+ *   -EINVAL  bad name, label, depth or flags (POLLING on a publisher)
+ *   -ENOSPC  the topic has PUBLISHERS/SUBSCRIBERS_PER_TOPIC_MAX endpoints,
+ *            or the namespace has too many topics
+ */
+struct agnocast_add_endpoint {
+	char topic[AGNOCAST_TOPIC_NAME_MAX];
+	char node[AGNOCAST_NODE_NAME_MAX];
+	__u32 depth;
+	__u32 flags;
+	__u32 topic_handle;
+	__u32 id;
+};
+
+/*
+ * AGNOCAST_IOC_REMOVE_PUBLISHER, AGNOCAST_IOC_REMOVE_SUBSCRIBER
+ *
+ * A removed publisher's entries stay while subscribers hold them; they come
+ * back for freeing through PUBLISH/RECLAIM of the same process.
+ */
+struct agnocast_remove_endpoint {
+	__u32 topic_handle;
+	__u32 id;
+};
+
+/*
+ * AGNOCAST_IOC_PUBLISH
+ *
+ * in:  addr inside the caller's own pool; bytes, the message's size for the
+ *      bandwidth counter; wake_ids/wake_capacity, a __u32 array for the ids of
+ *      callback subscribers to notify; reclaim/reclaim_capacity, a __u64 array
+ *      for addresses of the caller's entries that no one references any more.
+ * out: entry_id; wake_count; reclaim_count; reclaim_pending, how many more
+ *      freeable addresses wait for the next PUBLISH or RECLAIM.
+ *
+ * The entry joins the publisher's window of depth newest entries and every
+ * current subscriber's unreceived list; a subscriber over its depth loses its
+ * oldest unreceived entry, counted as dropped.
+ *
+ *   -EFAULT  addr is outside the caller's pool
+ *   -ENOBUFS wake_capacity is below the topic's subscriber count
+ *   -EBUSY   the caller's pool is not attached yet
+ */
+struct agnocast_publish {
+	__u32 topic_handle;
+	__u32 publisher_id;
+	__u64 addr;
+	__u64 bytes;
+	__u64 wake_ids;
+	__u64 reclaim;
+	__u32 wake_capacity;
+	__u32 reclaim_capacity;
+	__u64 entry_id;
+	__u32 wake_count;
+	__u32 reclaim_count;
+	__u32 reclaim_pending;
+	__u32 reserved;
+};
+
+/*
+ * AGNOCAST_IOC_RECLAIM: only the reclaim part of PUBLISH.
+ */
+struct agnocast_reclaim {
+	__u64 reclaim;
+	__u32 reclaim_capacity;
+	__u32 reclaim_count;
+	__u32 reclaim_pending;
+	__u32 reserved;
+};
+
+/* One received entry. */
+struct agnocast_entry {
+	__u64 entry_id;
+	__u64 addr;
+	__u32 publisher_id;
+	__u32 reserved;
+};
+
+/*
+ * A publisher pool the caller has not been given yet: fd is a new read-only
+ * O_CLOEXEC descriptor of it, to be mapped PROT_READ, MAP_SHARED at addr.
+ * The kernel hands each pool to a process once.
+ */
+struct agnocast_pool {
+	__u64 addr;
+	__u64 size;
+	__s32 fd;
+	__s32 pid;
+};
+
+/*
+ * AGNOCAST_IOC_RECEIVE (callback subscribers)
+ *
+ * in:  entries/entry_capacity, pools/pool_capacity (arrays of the structs
+ *      above).
+ * out: up to entry_capacity unreceived entries, oldest first, now held by the
+ *      subscriber until RELEASE; the pools they live in that the caller has
+ *      not been given; remaining, how many unreceived entries are left.
+ *
+ *   -EINVAL  entry_capacity or pool_capacity is zero
+ */
+struct agnocast_receive {
+	__u32 topic_handle;
+	__u32 subscriber_id;
+	__u64 entries;
+	__u64 pools;
+	__u32 entry_capacity;
+	__u32 pool_capacity;
+	__u32 entry_count;
+	__u32 pool_count;
+	__u32 remaining;
+	__u32 reserved;
+};
+
+/*
+ * AGNOCAST_IOC_TAKE (polling subscribers)
+ *
+ * out: the newest unreceived entry, held until RELEASE (entry_count 1), or
+ *      nothing (entry_count 0).  Older unreceived entries are passed over.
+ *      pool is filled (pool_count 1) when the caller has not been given it.
+ */
+struct agnocast_take {
+	__u32 topic_handle;
+	__u32 subscriber_id;
+	struct agnocast_entry entry;
+	struct agnocast_pool pool;
+	__u32 entry_count;
+	__u32 pool_count;
+};
+
+/*
+ * AGNOCAST_IOC_RELEASE: the subscriber drops its reference to entry_id.
+ *
+ *   -ENOENT  the subscriber does not hold that entry
+ */
+struct agnocast_release {
+	__u32 topic_handle;
+	__u32 subscriber_id;
+	__u64 entry_id;
+};
+
+/* Introspection: callable without registering. */
+
+struct agnocast_topic_summary {
+	char name[AGNOCAST_TOPIC_NAME_MAX];
+	__u32 publishers;
+	__u32 subscribers;
+};
+
+/*
+ * AGNOCAST_IOC_LIST_TOPICS
+ *
+ * out: total, the number of topics with at least one endpoint; the first
+ *      min(total, capacity) of them, in name order, in topics[].
+ */
+struct agnocast_list_topics {
+	__u64 topics;
+	__u32 capacity;
+	__u32 total;
+};
+
+struct agnocast_publisher_info {
+	char node[AGNOCAST_NODE_NAME_MAX];
+	__u32 id;
+	__s32 pid;
+	__u32 depth;
+	__u32 flags;
+	__u64 published;
+	__u64 published_bytes;
+	__u32 window;
+	__u32 reserved;
+};
+
+struct agnocast_subscriber_info {
+	char node[AGNOCAST_NODE_NAME_MAX];
+	__u32 id;
+	__s32 pid;
+	__u32 depth;
+	__u32 flags;
+	__u32 unreceived;
+	__u32 held;
+	__u64 received;
+	__u64 dropped;
+};
+
+/*
+ * AGNOCAST_IOC_TOPIC_INFO
+ *
+ * in:  name; publishers/subscribers arrays and their capacities.
+ * out: totals and the first min(total, capacity) endpoints by id; entries,
+ *      the number of live entries of the topic.
+ *
+ *   -ENOENT  no topic of that name has an endpoint
+ */
+struct agnocast_topic_info {
+	char name[AGNOCAST_TOPIC_NAME_MAX];
+	__u64 publishers;
+	__u64 subscribers;
+	__u32 publisher_capacity;
+	__u32 subscriber_capacity;
+	__u32 publisher_total;
+	__u32 subscriber_total;
+	__u32 entries;
+	__u32 reserved;
+};
+
+struct agnocast_process_info {
+	__s32 pid;
+	__u32 publishers;
+	__u32 subscribers;
+	__u32 pools_mapped;
+	__u64 pool_addr;
+	__u64 pool_size;
+};
+
+/*
+ * AGNOCAST_IOC_LIST_PROCESSES: registered processes of the caller's
+ * namespace, by pid.
+ */
+struct agnocast_list_processes {
+	__u64 processes;
+	__u32 capacity;
+	__u32 total;
+};
+
+#define AGNOCAST_IOC_MAGIC 0xAC
+
+#define AGNOCAST_IOC_GET_VERSION _IOR(AGNOCAST_IOC_MAGIC, 0, struct agnocast_version)
+#define AGNOCAST_IOC_REGISTER_PROCESS \
+	_IOWR(AGNOCAST_IOC_MAGIC, 1, struct agnocast_register_process)
+#define AGNOCAST_IOC_UNREGISTER_PROCESS _IO(AGNOCAST_IOC_MAGIC, 2)
+#define AGNOCAST_IOC_ADD_PUBLISHER _IOWR(AGNOCAST_IOC_MAGIC, 3, struct agnocast_add_endpoint)
+#define AGNOCAST_IOC_REMOVE_PUBLISHER _IOW(AGNOCAST_IOC_MAGIC, 4, struct agnocast_remove_endpoint)
+#define AGNOCAST_IOC_ADD_SUBSCRIBER _IOWR(AGNOCAST_IOC_MAGIC, 5, struct agnocast_add_endpoint)
+#define AGNOCAST_IOC_REMOVE_SUBSCRIBER \
+	_IOW(AGNOCAST_IOC_MAGIC, 6, struct agnocast_remove_endpoint)
+#define AGNOCAST_IOC_PUBLISH _IOWR(AGNOCAST_IOC_MAGIC, 7, struct agnocast_publish)
+#define AGNOCAST_IOC_RECLAIM _IOWR(AGNOCAST_IOC_MAGIC, 8, struct agnocast_reclaim)
+#define AGNOCAST_IOC_RECEIVE _IOWR(AGNOCAST_IOC_MAGIC, 9, struct agnocast_receive)
+#define AGNOCAST_IOC_TAKE _IOWR(AGNOCAST_IOC_MAGIC, 10, struct agnocast_take)
+#define AGNOCAST_IOC_RELEASE _IOW(AGNOCAST_IOC_MAGIC, 11, struct agnocast_release)
+#define AGNOCAST_IOC_LIST_TOPICS _IOWR(AGNOCAST_IOC_MAGIC, 12, struct agnocast_list_topics)
+#define AGNOCAST_IOC_TOPIC_INFO _IOWR(AGNOCAST_IOC_MAGIC, 13, struct agnocast_topic_info)
+#define AGNOCAST_IOC_LIST_PROCESSES \
+	_IOWR(AGNOCAST_IOC_MAGIC, 14, struct agnocast_list_processes)
+
+/*
+ * Exit records: read() on /dev/agnocast returns whole records, oldest first,
+ * of the caller's namespace; poll() reports POLLIN while any wait.  Records
+ * stay queued until read, so a restarted daemon misses none; past
+ * AGNOCAST_EXIT_RECORDS_MAX the oldest are discarded.  Reading needs
+ * CAP_SYS_ADMIN in the namespace's user namespace (-EPERM otherwise); a
+ * buffer smaller than one record is -EINVAL; with none waiting, read blocks
+ * or, with O_NONBLOCK, fails with -EAGAIN.
+ *
+ * A dead process yields one AGNOCAST_EXIT_PROCESS record, preceded by one
+ * AGNOCAST_EXIT_QUEUE record per callback subscriber it owned, naming the
+ * notification queue's topic and subscriber id.
+ */
+#define AGNOCAST_EXIT_RECORDS_MAX 4096
+
+#define AGNOCAST_EXIT_PROCESS 1
+#define AGNOCAST_EXIT_QUEUE 2
+
+struct agnocast_exit_record {
+	__u32 kind;
+	__s32 pid;
+	__u32 subscriber_id;
+	__u32 reserved;
+	char topic[AGNOCAST_TOPIC_NAME_MAX];
+};
+
+#endif /* _UAPI_LINUX_AGNOCAST_H */

@@ -207,9 +207,9 @@ int agnocast_pool_attach(struct agnocast_mempool *pool, int fd);
 void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool);
 bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
 				const struct agnocast_mempool *pool);
-int agnocast_pool_give(struct agnocast_proc *proc, struct agnocast_mempool *pool,
-		       struct agnocast_pool *out);
-void agnocast_pool_mark_given(struct agnocast_proc *proc, struct agnocast_mempool *pool);
+int agnocast_pool_prepare(struct agnocast_mempool *pool, struct agnocast_pool *out);
+void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool *pool,
+			     int fd);
 void agnocast_pool_drop_given(struct agnocast_proc *proc);
 
 /* agnocast_topic.c */

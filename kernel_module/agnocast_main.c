@@ -1,0 +1,197 @@
+// SPDX-License-Identifier: GPL-2.0
+/*
+ * agnocast: module parameters, the /dev/agnocast device and ioctl dispatch.
+ *
+ * The ioctl handler is a thin switch; each command lives in the file that
+ * owns its state and copies its own argument in and out.  Every open file
+ * holds a user reference on the opener's namespace state, which read() and
+ * poll() use for exit records.
+ */
+#include <linux/fs.h>
+#include <linux/miscdevice.h>
+#include <linux/mm.h>
+#include <linux/module.h>
+#include <linux/overflow.h>
+#include <linux/poll.h>
+#include <linux/uaccess.h>
+
+#include "agnocast_internal.h"
+
+unsigned long agnocast_pool_size = 1UL << 30;
+module_param_named(pool_size, agnocast_pool_size, ulong, 0444);
+MODULE_PARM_DESC(pool_size, "Bytes per process pool (page multiple, default 1 GiB)");
+
+unsigned int agnocast_pool_count = 1024;
+module_param_named(pool_count, agnocast_pool_count, uint, 0444);
+MODULE_PARM_DESC(pool_count, "Pool slots per IPC namespace (default 1024)");
+
+unsigned long agnocast_pool_base = 0x40000000000UL;
+module_param_named(pool_base, agnocast_pool_base, ulong, 0444);
+MODULE_PARM_DESC(pool_base, "Address of slot 0 (page aligned, default 0x40000000000)");
+
+/* Keeps bitmaps and slot tables of a namespace reasonably small. */
+#define AGNOCAST_POOL_COUNT_MAX 65536
+/* Lowest user address a pool may start at: far above any mmap_min_addr. */
+#define AGNOCAST_POOL_BASE_MIN (1UL << 32)
+
+static int agnocast_params_valid(void)
+{
+	unsigned long span, end;
+
+	if (!agnocast_pool_size || !PAGE_ALIGNED(agnocast_pool_size)) {
+		pr_err("agnocast: pool_size=%lu must be a nonzero multiple of %lu\n",
+		       agnocast_pool_size, PAGE_SIZE);
+		return -EINVAL;
+	}
+	if (!agnocast_pool_count || agnocast_pool_count > AGNOCAST_POOL_COUNT_MAX) {
+		pr_err("agnocast: pool_count=%u must be within 1..%u\n",
+		       agnocast_pool_count, AGNOCAST_POOL_COUNT_MAX);
+		return -EINVAL;
+	}
+	if (!PAGE_ALIGNED(agnocast_pool_base) || agnocast_pool_base < AGNOCAST_POOL_BASE_MIN) {
+		pr_err("agnocast: pool_base=%#lx must be page aligned and at least %#lx\n",
+		       agnocast_pool_base, AGNOCAST_POOL_BASE_MIN);
+		return -EINVAL;
+	}
+	if (check_mul_overflow(agnocast_pool_size, (unsigned long)agnocast_pool_count, &span) ||
+	    check_add_overflow(agnocast_pool_base, span, &end) || end > DEFAULT_MAP_WINDOW) {
+		pr_err("agnocast: pool_base=%#lx + pool_count=%u * pool_size=%lu exceeds the user address space (%#lx)\n",
+		       agnocast_pool_base, agnocast_pool_count, agnocast_pool_size,
+		       DEFAULT_MAP_WINDOW);
+		return -EINVAL;
+	}
+	return 0;
+}
+
+static int agnocast_get_version(void __user *uarg)
+{
+	struct agnocast_version version = {
+		.major = AGNOCAST_VERSION_MAJOR,
+		.minor = AGNOCAST_VERSION_MINOR,
+		.patch = AGNOCAST_VERSION_PATCH,
+	};
+
+	return copy_to_user(uarg, &version, sizeof(version)) ? -EFAULT : 0;
+}
+
+static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long arg)
+{
+	void __user *uarg = (void __user *)arg;
+
+	switch (cmd) {
+	case AGNOCAST_IOC_GET_VERSION:
+		return agnocast_get_version(uarg);
+	case AGNOCAST_IOC_REGISTER_PROCESS:
+		return agnocast_register_process(uarg);
+	case AGNOCAST_IOC_UNREGISTER_PROCESS:
+		return agnocast_unregister_process();
+	case AGNOCAST_IOC_ADD_PUBLISHER:
+		return agnocast_add_publisher(uarg);
+	case AGNOCAST_IOC_REMOVE_PUBLISHER:
+		return agnocast_remove_publisher(uarg);
+	case AGNOCAST_IOC_ADD_SUBSCRIBER:
+		return agnocast_add_subscriber(uarg);
+	case AGNOCAST_IOC_REMOVE_SUBSCRIBER:
+		return agnocast_remove_subscriber(uarg);
+	case AGNOCAST_IOC_PUBLISH:
+		return agnocast_publish(uarg);
+	case AGNOCAST_IOC_RECLAIM:
+		return agnocast_reclaim(uarg);
+	case AGNOCAST_IOC_RECEIVE:
+		return agnocast_receive(uarg);
+	case AGNOCAST_IOC_TAKE:
+		return agnocast_take(uarg);
+	case AGNOCAST_IOC_RELEASE:
+		return agnocast_release(uarg);
+	case AGNOCAST_IOC_LIST_TOPICS:
+		return agnocast_list_topics(uarg);
+	case AGNOCAST_IOC_TOPIC_INFO:
+		return agnocast_topic_info(uarg);
+	case AGNOCAST_IOC_LIST_PROCESSES:
+		return agnocast_list_processes(uarg);
+	default:
+		return -ENOTTY;
+	}
+}
+
+static int agnocast_dev_open(struct inode *inode, struct file *file)
+{
+	struct agnocast_ns *ns = agnocast_ns_get_current();
+
+	if (!ns)
+		return -ENOMEM;
+	file->private_data = ns;
+	return 0;
+}
+
+static int agnocast_dev_release(struct inode *inode, struct file *file)
+{
+	agnocast_ns_put(file->private_data);
+	return 0;
+}
+
+static ssize_t agnocast_dev_read(struct file *file, char __user *buf, size_t count, loff_t *ppos)
+{
+	return agnocast_read_exit_records(file->private_data, buf, count,
+					  file->f_flags & O_NONBLOCK);
+}
+
+static __poll_t agnocast_dev_poll(struct file *file, poll_table *wait)
+{
+	struct agnocast_ns *ns = file->private_data;
+
+	poll_wait(file, &ns->exit_wait, wait);
+	return READ_ONCE(ns->nr_exit_records) ? EPOLLIN | EPOLLRDNORM : 0;
+}
+
+static const struct file_operations agnocast_fops = {
+	.owner = THIS_MODULE,
+	.open = agnocast_dev_open,
+	.release = agnocast_dev_release,
+	.read = agnocast_dev_read,
+	.poll = agnocast_dev_poll,
+	.unlocked_ioctl = agnocast_ioctl,
+	.compat_ioctl = compat_ptr_ioctl,
+	.llseek = noop_llseek,
+};
+
+static struct miscdevice agnocast_misc = {
+	.minor = MISC_DYNAMIC_MINOR,
+	.name = "agnocast",
+	.fops = &agnocast_fops,
+	.mode = 0666,
+};
+
+static int __init agnocast_init(void)
+{
+	int ret;
+
+	ret = agnocast_params_valid();
+	if (ret)
+		return ret;
+	ret = agnocast_process_init();
+	if (ret)
+		return ret;
+	ret = misc_register(&agnocast_misc);
+	if (ret) {
+		pr_err("agnocast: cannot register /dev/agnocast: %d\n", ret);
+		agnocast_process_exit();
+		return ret;
+	}
+	return 0;
+}
+
+static void __exit agnocast_exit(void)
+{
+	misc_deregister(&agnocast_misc);
+	agnocast_process_exit();
+	agnocast_ns_exit();
+}
+
+module_init(agnocast_init);
+module_exit(agnocast_exit);
+
+MODULE_LICENSE("GPL");
+MODULE_DESCRIPTION("agnocast: zero-copy publish/subscribe bookkeeping");
+MODULE_VERSION(__stringify(AGNOCAST_VERSION_MAJOR) "." __stringify(
+	AGNOCAST_VERSION_MINOR) "." __stringify(AGNOCAST_VERSION_PATCH));

@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: GPL-2.0
+/*
+ * agnocast: pool slots and the pool files handed to subscribers.
+ *
+ * Slot i of a namespace is the range pool_base + i * pool_size, the same in
+ * every process.  A slot is reused only once its pool is unreachable: its
+ * owner is gone, no live process was given its file, and no entry lives in
+ * it.  Otherwise a new owner could be given an address range that a
+ * subscriber still has mapped.
+ *
+ * The owner attaches a tmpfs file; the kernel keeps only a read-only
+ * reopening of it, so whoever receives it can never map the pool writable.
+ *
+ * All state here is protected by the namespace lock (agnocast_ns.lock).
+ */
+#include <linux/bitmap.h>
+#include <linux/file.h>
+#include <linux/fs.h>
+#include <linux/magic.h>
+#include <linux/pid.h>
+#include <linux/pid_namespace.h>
+#include <linux/sched.h>
+#include <linux/slab.h>
+
+#include "agnocast_internal.h"
+
+struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
+					       struct agnocast_proc *owner)
+{
+	struct agnocast_mempool *pool;
+	unsigned long slot;
+
+	lockdep_assert_held(&ns->lock);
+	slot = find_first_zero_bit(ns->slot_map, agnocast_pool_count);
+	if (slot >= agnocast_pool_count)
+		return ERR_PTR(-ENOSPC);
+	pool = kzalloc(sizeof(*pool), GFP_KERNEL_ACCOUNT);
+	if (!pool)
+		return ERR_PTR(-ENOMEM);
+	pool->slot = slot;
+	pool->size = agnocast_pool_size;
+	pool->addr = agnocast_pool_base + slot * agnocast_pool_size;
+	pool->owner = owner;
+	pool->owner_pid = get_task_pid(current, PIDTYPE_TGID);
+	set_bit(slot, ns->slot_map);
+	ns->slots[slot] = pool;
+	return pool;
+}
+
+int agnocast_pool_attach(struct agnocast_mempool *pool, int fd)
+{
+	struct file *file, *ro;
+	struct inode *inode;
+	int ret = -EINVAL;
+
+	if (pool->file)
+		return -EBUSY;
+	file = fget(fd);
+	if (!file)
+		return -EBADF;
+	inode = file_inode(file);
+	/* Never hand out a read descriptor to what the owner cannot read. */
+	if (!(file->f_mode & FMODE_READ) || !S_ISREG(inode->i_mode) || inode->i_sb->s_magic != TMPFS_MAGIC ||
+	    i_size_read(inode) < pool->size)
+		goto out_put;
+
+	ro = dentry_open(&file->f_path, O_RDONLY | O_LARGEFILE, current_cred());
+	if (IS_ERR(ro)) {
+		ret = PTR_ERR(ro);
+		goto out_put;
+	}
+	pool->file = ro;
+	ret = 0;
+out_put:
+	fput(file);
+	return ret;
+}
+
+void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool)
+{
+	lockdep_assert_held(&ns->lock);
+	if (pool->owner || pool->mappers || pool->entries)
+		return;
+	clear_bit(pool->slot, ns->slot_map);
+	ns->slots[pool->slot] = NULL;
+	if (pool->file)
+		fput(pool->file);
+	put_pid(pool->owner_pid);
+	kfree(pool);
+}
+
+/* Whether @proc must be given @pool's file to read entries in it. */
+bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
+				const struct agnocast_mempool *pool)
+{
+	return pool->owner != proc && !test_bit(pool->slot, proc->given);
+}
+
+/*
+ * Handing a pool over is two-phase so that a call can fail without leaving a
+ * descriptor behind: agnocast_pool_prepare() reserves a descriptor number
+ * and describes the pool in @out; then either agnocast_pool_hand_over()
+ * installs the read-only file there, or put_unused_fd() gives the number back.
+ */
+int agnocast_pool_prepare(struct agnocast_mempool *pool, struct agnocast_pool *out)
+{
+	int fd;
+
+	if (WARN_ON_ONCE(!pool->file))
+		return -EINVAL;
+	fd = get_unused_fd_flags(O_CLOEXEC);
+	if (fd < 0)
+		return fd;
+	memset(out, 0, sizeof(*out));
+	out->addr = pool->addr;
+	out->size = pool->size;
+	out->fd = fd;
+	out->pid = pid_nr_ns(pool->owner_pid, task_active_pid_ns(current));
+	return 0;
+}
+
+void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool *pool,
+			     int fd)
+{
+	lockdep_assert_held(&proc->ns->lock);
+	fd_install(fd, get_file(pool->file));
+	if (__test_and_set_bit(pool->slot, proc->given))
+		return;
+	pool->mappers++;
+	proc->nr_given++;
+}
+
+/* Teardown: @proc no longer maps any pool it was given. */
+void agnocast_pool_drop_given(struct agnocast_proc *proc)
+{
+	struct agnocast_ns *ns = proc->ns;
+	struct agnocast_mempool *pool;
+	unsigned long slot;
+
+	lockdep_assert_held(&ns->lock);
+	for_each_set_bit(slot, proc->given, agnocast_pool_count) {
+		__clear_bit(slot, proc->given);
+		pool = ns->slots[slot];
+		if (WARN_ON_ONCE(!pool))
+			continue;
+		pool->mappers--;
+		agnocast_pool_maybe_free(ns, pool);
+	}
+	proc->nr_given = 0;
+}

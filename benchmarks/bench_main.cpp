@@ -1,0 +1,208 @@
+// agnocast-bench: every measurement of SPEC §9 in one run on one machine, so
+// the ratios between agnocast and its yardsticks hold even where absolute
+// times do not (the test VM runs under TCG emulation).
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "agnocast_roles.hpp"
+#include "baselines.hpp"
+#include "bench_support.hpp"
+#include "iceoryx_runner.hpp"
+
+namespace bench = agnocast::bench;
+using nlohmann::json;
+
+namespace {
+
+struct Plan {
+  std::vector<std::size_t> sizes{64, 4 << 10, 1 << 20, 16 << 20, 64 << 20};
+  std::vector<std::size_t> iceoryx_sizes{64, 4 << 10, 1 << 20};
+  std::vector<std::size_t> fanouts{1, 8, 64};
+  std::size_t fanout_size = 4 << 10;
+  std::size_t floor_count = 2000;
+  std::size_t throughput_count = 20000;
+
+  std::size_t latency_count(std::size_t size) const {
+    if (smoke) return 3;
+    return size >= (16u << 20) ? 20 : 300;
+  }
+  std::size_t fanout_count() const { return smoke ? 3 : 100; }
+  bool smoke = false;
+
+  void make_smoke() {
+    smoke = true;
+    floor_count = 20;
+    throughput_count = 200;
+  }
+};
+
+json stats_json(const bench::LatencyStats& stats) {
+  return {{"p50_us", stats.p50_us}, {"p99_us", stats.p99_us}, {"samples", stats.samples}};
+}
+
+// Publish-to-last-delivery: for each message, the slowest subscriber's latency.
+bench::LatencyStats last_delivery(const std::vector<std::vector<std::int64_t>>& per_subscriber) {
+  std::vector<std::int64_t> slowest(per_subscriber.front().size(), 0);
+  for (const auto& latencies : per_subscriber) {
+    for (std::size_t i = 0; i < slowest.size(); ++i) slowest[i] = std::max(slowest[i], latencies[i]);
+  }
+  return bench::summarize(std::move(slowest));
+}
+
+json machine_json() {
+  utsname names{};
+  uname(&names);
+  std::string cpu = "unknown";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  return {{"kernel", names.release},
+          {"cpu", cpu},
+          {"cpus", sysconf(_SC_NPROCESSORS_ONLN)},
+          {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024}};
+}
+
+double ratio(double numerator, double denominator) {
+  return denominator > 0 ? numerator / denominator : 0;
+}
+
+json run(const Plan& plan, const std::string& iceoryx_role) {
+  json report;
+  report["machine"] = machine_json();
+  report["smoke"] = plan.smoke;
+
+  std::cerr << "mqueue notification floor...\n";
+  auto floor = bench::run_mqueue_floor(plan.floor_count);
+  report["latency"]["mqueue_floor"]["1 B"] = stats_json(floor);
+
+  for (std::size_t size : plan.sizes) {
+    std::string label = bench::format_size(size);
+    std::cerr << "latency " << label << "...\n";
+    auto agnocast = bench::run_agnocast_latency(size, plan.latency_count(size), 1);
+    report["latency"]["agnocast"][label] = stats_json(bench::summarize(agnocast.front()));
+    auto copy = bench::run_unix_socket_copy(size, plan.latency_count(size));
+    report["latency"]["unix_socket"][label] = stats_json(copy);
+  }
+
+  if (auto iceoryx = bench::IceoryxRunner::start(iceoryx_role)) {
+    for (std::size_t size : plan.iceoryx_sizes) {
+      std::string label = bench::format_size(size);
+      std::cerr << "iceoryx latency " << label << "...\n";
+      report["latency"]["iceoryx"][label] = stats_json(iceoryx->measure(size, plan.latency_count(size)));
+    }
+  } else {
+    std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
+    report["latency"]["iceoryx"] = nullptr;
+  }
+
+  std::cerr << "throughput...\n";
+  auto throughput = bench::run_agnocast_throughput(64, plan.throughput_count);
+  report["throughput"] = {{"size_bytes", 64},
+                          {"published", throughput.published},
+                          {"received", throughput.received},
+                          {"messages_per_s", throughput.messages_per_s}};
+
+  for (std::size_t subscribers : plan.fanouts) {
+    std::cerr << "fan-out to " << subscribers << " subscribers...\n";
+    auto per_subscriber =
+        bench::run_agnocast_latency(plan.fanout_size, plan.fanout_count(), subscribers);
+    report["fanout"][std::to_string(subscribers)] = stats_json(last_delivery(per_subscriber));
+  }
+
+  const auto& latency = report["latency"];
+  auto p50 = [&](const char* who, const char* size) -> double {
+    const json& entry = latency[who];
+    if (entry.is_null() || !entry.contains(size)) return 0;
+    return entry[size]["p50_us"].get<double>();
+  };
+  auto fanout_p50 = [&](const char* n) { return report["fanout"][n]["p50_us"].get<double>(); };
+  report["ratios"] = {
+      {"size_flatness", ratio(p50("agnocast", "64 MiB"), p50("agnocast", "64 B"))},
+      {"vs_iceoryx", ratio(p50("agnocast", "4 KiB"), p50("iceoryx", "4 KiB"))},
+      {"vs_mqueue_floor", ratio(p50("agnocast", "64 B"), p50("mqueue_floor", "1 B"))},
+      {"fanout_64", ratio(fanout_p50("64"), fanout_p50("1"))},
+  };
+  report["targets"] = {{"size_flatness", 1.05},
+                       {"vs_iceoryx", 1.0},
+                       {"vs_mqueue_floor", 1.3},
+                       {"fanout_64", 64.0}};
+  return report;
+}
+
+void print_table(const json& report) {
+  std::printf("machine: %s, %lld CPUs, kernel %s\n",
+              report["machine"]["cpu"].get<std::string>().c_str(),
+              report["machine"]["cpus"].get<long long>(),
+              report["machine"]["kernel"].get<std::string>().c_str());
+  std::printf("\none-way latency, microseconds (p50 / p99)\n");
+  std::printf("%-10s %-22s %-22s %-22s\n", "payload", "agnocast", "unix socket (copy)", "iceoryx");
+  for (const auto& [label, agnocast] : report["latency"]["agnocast"].items()) {
+    auto cell = [&](const json& entry) {
+      if (entry.is_null() || !entry.contains(label)) return std::string("-");
+      char text[64];
+      std::snprintf(text, sizeof text, "%.1f / %.1f", entry[label]["p50_us"].get<double>(),
+                    entry[label]["p99_us"].get<double>());
+      return std::string(text);
+    };
+    std::printf("%-10s %-22s %-22s %-22s\n", label.c_str(), cell(report["latency"]["agnocast"]).c_str(),
+                cell(report["latency"]["unix_socket"]).c_str(),
+                cell(report["latency"]["iceoryx"]).c_str());
+  }
+  const json& floor = report["latency"]["mqueue_floor"]["1 B"];
+  std::printf("mqueue notification floor (1 B): %.1f / %.1f\n", floor["p50_us"].get<double>(),
+              floor["p99_us"].get<double>());
+  std::printf("\nthroughput (64 B): %.0f messages/s (%llu of %llu received)\n",
+              report["throughput"]["messages_per_s"].get<double>(),
+              report["throughput"]["received"].get<unsigned long long>(),
+              report["throughput"]["published"].get<unsigned long long>());
+  std::printf("\npublish to last delivery, 4 KiB, microseconds (p50 / p99)\n");
+  for (const auto& [subscribers, stats] : report["fanout"].items()) {
+    std::printf("%3s subscriber(s): %.1f / %.1f\n", subscribers.c_str(),
+                stats["p50_us"].get<double>(), stats["p99_us"].get<double>());
+  }
+  std::printf("\nratio            measured   target (lower is better)\n");
+  for (const auto& [name, value] : report["ratios"].items()) {
+    std::printf("%-16s %8.3f   %6.2f\n", name.c_str(), value.get<double>(),
+                report["targets"][name].get<double>());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"agnocast-bench: latency, throughput and fan-out against iceoryx and baselines"};
+  bool json_output = false, smoke = false;
+  std::string iceoryx_role =
+      (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "agnocast-bench-iceoryx")
+          .string();
+  app.add_flag("--json", json_output, "print one JSON object instead of tables");
+  app.add_flag("--smoke", smoke, "tiny counts: checks that every measurement works");
+  app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
+  CLI11_PARSE(app, argc, argv);
+
+  Plan plan;
+  if (smoke) plan.make_smoke();
+  try {
+    json report = run(plan, iceoryx_role);
+    if (json_output) {
+      std::cout << report.dump() << "\n";
+    } else {
+      print_table(report);
+    }
+  } catch (const std::exception& error) {
+    std::cerr << "agnocast-bench: " << error.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,32 @@
+// Runs the iceoryx latency roles (a separate program, since iceoryx is a
+// separate runtime) under a RouDi started for the purpose.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include "bench_support.hpp"
+
+namespace agnocast::bench {
+
+class IceoryxRunner {
+ public:
+  // Empty when iox-roudi or the role program is missing.
+  static std::optional<IceoryxRunner> start(const std::string& role_program);
+  ~IceoryxRunner();
+  IceoryxRunner(IceoryxRunner&& other) noexcept;
+  IceoryxRunner(const IceoryxRunner&) = delete;
+  IceoryxRunner& operator=(const IceoryxRunner&) = delete;
+  IceoryxRunner& operator=(IceoryxRunner&&) = delete;
+
+  LatencyStats measure(std::size_t size, std::size_t count);
+
+ private:
+  IceoryxRunner(std::string role_program, int roudi_pid)
+      : role_program_(std::move(role_program)), roudi_pid_(roudi_pid) {}
+  std::string role_program_;
+  int roudi_pid_ = -1;
+};
+
+}  // namespace agnocast::bench

@@ -1,0 +1,766 @@
+// Every command of the UAPI: each success path and each documented errno,
+// with outputs poisoned before the call and checked after.
+#include <sched.h>
+#include <poll.h>
+#include <sys/prctl.h>
+
+#include "test_util.h"
+
+using namespace agnocast_test;
+
+namespace {
+
+// The ABI: sizes are pinned so that no field moves unnoticed.
+static_assert(sizeof(agnocast_version) == 16);
+static_assert(sizeof(agnocast_register_process) == 24);
+static_assert(sizeof(agnocast_add_endpoint) == 400);
+static_assert(sizeof(agnocast_remove_endpoint) == 8);
+static_assert(sizeof(agnocast_publish) == 72);
+static_assert(sizeof(agnocast_reclaim) == 24);
+static_assert(sizeof(agnocast_entry) == 24);
+static_assert(sizeof(agnocast_pool) == 24);
+static_assert(sizeof(agnocast_receive) == 48);
+static_assert(sizeof(agnocast_take) == 64);
+static_assert(sizeof(agnocast_release) == 16);
+static_assert(sizeof(agnocast_topic_summary) == 264);
+static_assert(sizeof(agnocast_list_topics) == 16);
+static_assert(sizeof(agnocast_publisher_info) == 168);
+static_assert(sizeof(agnocast_subscriber_info) == 168);
+static_assert(sizeof(agnocast_topic_info) == 296);
+static_assert(sizeof(agnocast_process_info) == 32);
+static_assert(sizeof(agnocast_list_processes) == 16);
+static_assert(sizeof(agnocast_exit_record) == 272);
+
+void *const kBadPtr = reinterpret_cast<void *>(8);
+
+class Device : public ::testing::Test {
+ protected:
+  void SetUp() override
+  {
+    dev = open_device();
+    ASSERT_GE(dev, 0) << strerror(errno);
+  }
+  void TearDown() override
+  {
+    reg.drop();
+    close(dev);
+  }
+  void registered() { ASSERT_EQ(reg.full(dev), 0); }
+
+  int dev = -1;
+  Registration reg;
+};
+
+TEST(Abi, VersionMacrosMatchModuleVersion)
+{
+  EXPECT_EQ(AGNOCAST_VERSION_MAJOR, 0);
+  EXPECT_EQ(AGNOCAST_IOC_MAGIC, 0xAC);
+}
+
+TEST_F(Device, GetVersion)
+{
+  auto v = poisoned<agnocast_version>();
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_GET_VERSION, &v), 0);
+  EXPECT_EQ(v.major, AGNOCAST_VERSION_MAJOR);
+  EXPECT_EQ(v.minor, AGNOCAST_VERSION_MINOR);
+  EXPECT_EQ(v.patch, AGNOCAST_VERSION_PATCH);
+  EXPECT_EQ(v.reserved, 0u);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_GET_VERSION, static_cast<agnocast_version *>(kBadPtr)), -EFAULT);
+}
+
+TEST_F(Device, UnknownCommandIsEnotty)
+{
+  int dummy = 0;
+  EXPECT_EQ(ioc(dev, _IO(AGNOCAST_IOC_MAGIC, 99), &dummy), -ENOTTY);
+  EXPECT_EQ(ioc(dev, _IOWR(AGNOCAST_IOC_MAGIC, 1, int), &dummy), -ENOTTY);
+  EXPECT_EQ(ioc(dev, _IOR('x', 0, agnocast_version), &dummy), -ENOTTY);
+}
+
+TEST_F(Device, RegisterReservesSlotAndRepeats)
+{
+  auto r = poisoned<agnocast_register_process>();
+  r.pool_fd = -1;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);
+  EXPECT_EQ(r.pool_fd, -1);
+  EXPECT_EQ(r.pid, getpid());
+  EXPECT_GE(r.pool_addr, 0x40000000000ull);
+  EXPECT_EQ(r.pool_addr % 4096, 0u);
+  EXPECT_GT(r.pool_size, 0u);
+  auto again = poisoned<agnocast_register_process>();
+  again.pool_fd = -1;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &again), 0);
+  EXPECT_EQ(again.pool_addr, r.pool_addr);
+  EXPECT_EQ(again.pool_size, r.pool_size);
+  EXPECT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), 0);
+}
+
+TEST_F(Device, RegisterErrors)
+{
+  auto r = poisoned<agnocast_register_process>();
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS,
+                static_cast<agnocast_register_process *>(kBadPtr)),
+            -EFAULT);
+  // Attaching before reserving.
+  r.pool_fd = 0;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -ESRCH);
+  r.pool_fd = -2;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBADF);
+
+  ASSERT_EQ(reg.reserve(dev), 0);
+  r = poisoned<agnocast_register_process>();
+  r.pool_fd = 4000;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBADF);
+
+  // Not tmpfs: a pipe and a procfs file.
+  int pipefd[2];
+  ASSERT_EQ(pipe(pipefd), 0);
+  r.pool_fd = pipefd[0];
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  close(pipefd[0]);
+  close(pipefd[1]);
+  int procfd = open("/proc/self/status", O_RDONLY);
+  r.pool_fd = procfd;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  close(procfd);
+
+  // Too small.
+  int small = memfd_create("small", MFD_CLOEXEC);
+  ASSERT_EQ(ftruncate(small, static_cast<off_t>(reg.size - 4096)), 0);
+  r.pool_fd = small;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  close(small);
+
+  // Not readable through the given descriptor.
+  int full = memfd_create("wronly", MFD_CLOEXEC);
+  ASSERT_EQ(ftruncate(full, static_cast<off_t>(reg.size)), 0);
+  std::string path = "/proc/self/fd/" + std::to_string(full);
+  int wronly = open(path.c_str(), O_WRONLY);
+  ASSERT_GE(wronly, 0);
+  r.pool_fd = wronly;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  close(wronly);
+  close(full);
+
+  ASSERT_EQ(reg.attach(), 0);
+  r = poisoned<agnocast_register_process>();
+  r.pool_fd = reg.memfd;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBUSY);
+  // Step one after attaching still reports the slot.
+  r = poisoned<agnocast_register_process>();
+  r.pool_fd = -1;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);
+  EXPECT_EQ(r.pool_addr, reg.addr);
+  EXPECT_EQ(r.pid, getpid());
+}
+
+TEST_F(Device, Unregister)
+{
+  EXPECT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), -ESRCH);
+  registered();
+  EXPECT_TRUE(process_listed(dev, getpid()));
+  EXPECT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), 0);
+  EXPECT_FALSE(process_listed(dev, getpid()));
+  EXPECT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), -ESRCH);
+  Endpoint ep;
+  EXPECT_EQ(add_publisher(dev, "/t", 1, &ep), -ESRCH);
+}
+
+TEST_F(Device, EndpointCommandsNeedRegistration)
+{
+  Endpoint ep;
+  EXPECT_EQ(add_publisher(dev, "/t", 1, &ep), -ESRCH);
+  EXPECT_EQ(add_subscriber(dev, "/t", 1, &ep), -ESRCH);
+  agnocast_remove_endpoint rm{1, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ESRCH);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), -ESRCH);
+  EXPECT_EQ(publish(dev, {1, 0}, 0x40000000000ull), -ESRCH);
+  auto rc = poisoned<agnocast_reclaim>();
+  rc.reserved = 0;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), -ESRCH);
+  ReceiveResult rr;
+  EXPECT_EQ(receive(dev, {1, 0}, &rr), -ESRCH);
+  auto take = poisoned<agnocast_take>();
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -ESRCH);
+  EXPECT_EQ(release(dev, {1, 0}, 0), -ESRCH);
+}
+
+TEST_F(Device, AddEndpointsShareIdsPerTopic)
+{
+  registered();
+  auto ep = endpoint("/chatter", 10, 0, "talker");
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), 0);
+  EXPECT_EQ(ep.id, 0u);
+  EXPECT_GT(ep.topic_handle, 0u);
+  EXPECT_EQ(ep.depth, 10u);
+  uint32_t handle = ep.topic_handle;
+  ep = endpoint("/chatter", 3, AGNOCAST_TRANSIENT_LOCAL, "listener");
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), 0);
+  EXPECT_EQ(ep.id, 1u);
+  EXPECT_EQ(ep.topic_handle, handle);
+  ep = endpoint("/chatter", 1, AGNOCAST_POLLING, "");
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), 0);
+  EXPECT_EQ(ep.id, 2u);
+
+  agnocast_topic_info info;
+  std::vector<agnocast_publisher_info> pubs;
+  std::vector<agnocast_subscriber_info> subs;
+  ASSERT_EQ(topic_info(dev, "/chatter", &info, &pubs, &subs), 0);
+  EXPECT_EQ(info.publisher_total, 1u);
+  EXPECT_EQ(info.subscriber_total, 2u);
+  EXPECT_EQ(info.entries, 0u);
+  EXPECT_EQ(info.reserved, 0u);
+  ASSERT_EQ(pubs.size(), 1u);
+  EXPECT_STREQ(pubs[0].node, "talker");
+  EXPECT_EQ(pubs[0].pid, getpid());
+  EXPECT_EQ(pubs[0].depth, 10u);
+  EXPECT_EQ(pubs[0].flags, 0u);
+  EXPECT_EQ(pubs[0].published, 0u);
+  EXPECT_EQ(pubs[0].window, 0u);
+  EXPECT_EQ(pubs[0].reserved, 0u);
+  ASSERT_EQ(subs.size(), 2u);
+  EXPECT_EQ(subs[0].id, 1u);
+  EXPECT_STREQ(subs[0].node, "listener");
+  EXPECT_EQ(subs[0].flags, static_cast<uint32_t>(AGNOCAST_TRANSIENT_LOCAL));
+  EXPECT_EQ(subs[1].id, 2u);
+  EXPECT_EQ(subs[1].flags, static_cast<uint32_t>(AGNOCAST_POLLING));
+  EXPECT_EQ(subs[1].unreceived, 0u);
+  EXPECT_EQ(subs[1].held, 0u);
+  EXPECT_EQ(subs[1].dropped, 0u);
+}
+
+TEST_F(Device, IdsNeverCollideAcrossMangledNames)
+{
+  registered();
+  Endpoint a, b, c;
+  ASSERT_EQ(add_subscriber(dev, "/a/b", 1, &a), 0);
+  ASSERT_EQ(add_subscriber(dev, "/a_b", 1, &b), 0);
+  EXPECT_NE(a.handle, b.handle);
+  EXPECT_EQ(a.id, 0u);
+  EXPECT_EQ(b.id, 1u);
+  // Ids are not reused after a topic goes away and comes back.
+  agnocast_remove_endpoint rm{a.handle, a.id};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), 0);
+  rm = {b.handle, b.id};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), 0);
+  agnocast_topic_info info;
+  EXPECT_EQ(topic_info(dev, "/a/b", &info), -ENOENT);
+  ASSERT_EQ(add_subscriber(dev, "/a/b", 1, &c), 0);
+  EXPECT_EQ(c.id, 2u);
+}
+
+TEST_F(Device, AddEndpointRejectsBadInput)
+{
+  registered();
+  for (const char *name : {"", "a", "/", "//", "//a", "/a/", "/a//b", "/a-b", "/a b", "/a.b",
+                           "/\xc3\xa9", "a/b"}) {
+    auto ep = endpoint(name, 1);
+    EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL) << name;
+    EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL) << name;
+  }
+  auto ep = endpoint("/ok", 1);
+  std::memset(ep.topic, 'a', sizeof(ep.topic));
+  ep.topic[0] = '/';
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);  // unterminated
+  ep = endpoint("/ok", 1, 0, "bad\x01label");
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  ep = endpoint("/ok", 1, 0, "\x7f");
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);
+  ep = endpoint("/ok", 1);
+  std::memset(ep.node, 'n', sizeof(ep.node));
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);  // unterminated
+  ep = endpoint("/ok", 0);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  ep = endpoint("/ok", AGNOCAST_DEPTH_MAX + 1);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);
+  ep = endpoint("/ok", 1, 1u << 2);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);
+  ep = endpoint("/ok", 1, AGNOCAST_POLLING);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, static_cast<agnocast_add_endpoint *>(kBadPtr)),
+            -EFAULT);
+  // A 255-character name and the maximum depth are fine.
+  std::string longest = "/" + std::string(254, 'x');
+  Endpoint ok;
+  EXPECT_EQ(add_subscriber(dev, longest, AGNOCAST_DEPTH_MAX, &ok), 0);
+  // Nothing was left behind by the failures.
+  agnocast_topic_info info;
+  EXPECT_EQ(topic_info(dev, "/ok", &info), -ENOENT);
+}
+
+TEST_F(Device, TooManyEndpointsIsEnospc)
+{
+  registered();
+  Endpoint ep;
+  for (int i = 0; i < AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX; i++)
+    ASSERT_EQ(add_subscriber(dev, "/crowd", 1, &ep), 0) << i;
+  EXPECT_EQ(add_subscriber(dev, "/crowd", 1, &ep), -ENOSPC);
+  for (int i = 0; i < AGNOCAST_PUBLISHERS_PER_TOPIC_MAX; i++)
+    ASSERT_EQ(add_publisher(dev, "/crowd", 1, &ep), 0) << i;
+  EXPECT_EQ(add_publisher(dev, "/crowd", 1, &ep), -ENOSPC);
+}
+
+TEST_F(Device, RemoveEndpoint)
+{
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/rm", 1, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/rm", 1, &sub), 0);
+  agnocast_remove_endpoint rm{pub.handle + 1000, pub.id};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ENOENT);
+  rm = {0xffffffffu, pub.id};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ENOENT);
+  rm = {pub.handle, 77};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ENOENT);
+  rm = {sub.handle, sub.id};  // a subscriber id is not a publisher
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ENOENT);
+  rm = {pub.handle, pub.id};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), -ENOENT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER,
+                static_cast<agnocast_remove_endpoint *>(kBadPtr)),
+            -EFAULT);
+  // Another process may not remove ours.
+  EXPECT_EQ(in_child([&] {
+              Registration child;
+              if (child.full(dev)) return 10;
+              agnocast_remove_endpoint r{pub.handle, pub.id};
+              if (ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &r) != -EPERM) return 11;
+              r = {sub.handle, sub.id};
+              if (ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &r) != -EPERM) return 12;
+              if (publish(dev, pub, child.addr) != -EPERM) return 13;
+              ReceiveResult rr;
+              if (receive(dev, sub, &rr) != -EPERM) return 14;
+              if (release(dev, sub, 0) != -EPERM) return 15;
+              return 0;
+            }),
+            0);
+  rm = {pub.handle, pub.id};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), 0);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ENOENT);
+  rm = {sub.handle, sub.id};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), 0);
+  // The topic is gone with its last endpoint, and so is its handle.
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), -ENOENT);
+  agnocast_topic_info info;
+  EXPECT_EQ(topic_info(dev, "/rm", &info), -ENOENT);
+  drain_exit_records(dev);
+}
+
+TEST_F(Device, PublishReceiveRelease)
+{
+  registered();
+  Endpoint pub, cb, poll;
+  ASSERT_EQ(add_publisher(dev, "/pr", 2, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/pr", 2, &cb), 0);
+  ASSERT_EQ(add_subscriber(dev, "/pr", 2, &poll, AGNOCAST_POLLING), 0);
+
+  PublishResult res;
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64, &res), 0);
+  EXPECT_EQ(res.entry_id, 0u);
+  ASSERT_EQ(res.wake.size(), 1u);  // the polling subscriber is never woken
+  EXPECT_EQ(res.wake[0], cb.id);
+  EXPECT_TRUE(res.reclaim.empty());
+  EXPECT_EQ(res.reclaim_pending, 0u);
+  ASSERT_EQ(publish(dev, pub, reg.addr + 128, &res), 0);
+  EXPECT_EQ(res.entry_id, 1u);
+
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, cb, &rr, 1), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  EXPECT_EQ(rr.entries[0].entry_id, 0u);
+  EXPECT_EQ(rr.entries[0].addr, reg.addr + 64);
+  EXPECT_EQ(rr.entries[0].publisher_id, pub.id);
+  EXPECT_EQ(rr.entries[0].reserved, 0u);
+  EXPECT_TRUE(rr.pools.empty());  // our own pool is never handed to us
+  EXPECT_EQ(rr.remaining, 1u);
+  ASSERT_EQ(receive(dev, cb, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  EXPECT_EQ(rr.entries[0].entry_id, 1u);
+  EXPECT_EQ(rr.remaining, 0u);
+  ASSERT_EQ(receive(dev, cb, &rr), 0);
+  EXPECT_TRUE(rr.entries.empty());
+
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  std::vector<agnocast_publisher_info> pubs;
+  ASSERT_EQ(topic_info(dev, "/pr", &info, &pubs, &subs), 0);
+  EXPECT_EQ(info.entries, 2u);
+  EXPECT_EQ(pubs[0].published, 2u);
+  EXPECT_EQ(pubs[0].published_bytes, 16u);
+  EXPECT_EQ(pubs[0].window, 2u);
+  EXPECT_EQ(subs[0].held, 2u);
+  EXPECT_EQ(subs[0].received, 2u);
+  EXPECT_EQ(subs[1].unreceived, 2u);
+
+  EXPECT_EQ(release(dev, cb, 5), -ENOENT);
+  EXPECT_EQ(release(dev, poll, 0), -ENOENT);  // unreceived is not held
+  EXPECT_EQ(release(dev, cb, 0), 0);
+  EXPECT_EQ(release(dev, cb, 0), -ENOENT);
+  EXPECT_EQ(release(dev, {cb.handle, 99}, 1), -ENOENT);
+  EXPECT_EQ(release(dev, {0, cb.id}, 1), -ENOENT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RELEASE, static_cast<agnocast_release *>(kBadPtr)), -EFAULT);
+
+  // Entry 0 is still unreceived by the polling subscriber.  A third publish
+  // pushes it out of the window of 2; the polling subscriber over its depth
+  // drops it, and then nobody references it: it comes back for reclaim.
+  ASSERT_EQ(publish(dev, pub, reg.addr + 192, &res), 0);
+  ASSERT_EQ(res.reclaim.size(), 1u);
+  EXPECT_EQ(res.reclaim[0], reg.addr + 64);
+  ASSERT_EQ(topic_info(dev, "/pr", &info, &pubs, &subs), 0);
+  EXPECT_EQ(subs[1].dropped, 1u);
+  EXPECT_EQ(subs[1].unreceived, 2u);
+}
+
+TEST_F(Device, PublishErrors)
+{
+  Endpoint pub;
+  // Slot reserved but no pool attached yet: -EBUSY.
+  ASSERT_EQ(reg.reserve(dev), 0);
+  ASSERT_EQ(add_publisher(dev, "/pe", 1, &pub), 0);
+  EXPECT_EQ(publish(dev, pub, reg.addr), -EBUSY);
+  ASSERT_EQ(reg.attach(), 0);
+
+  EXPECT_EQ(publish(dev, pub, reg.addr - 1), -EFAULT);
+  EXPECT_EQ(publish(dev, pub, reg.addr + reg.size), -EFAULT);
+  EXPECT_EQ(publish(dev, pub, 0), -EFAULT);
+  EXPECT_EQ(publish(dev, {pub.handle + 1000, pub.id}, reg.addr), -ENOENT);
+  EXPECT_EQ(publish(dev, {pub.handle, pub.id + 5}, reg.addr), -ENOENT);
+
+  auto arg = poisoned<agnocast_publish>();
+  arg.topic_handle = pub.handle;
+  arg.publisher_id = pub.id;
+  arg.addr = reg.addr;
+  arg.reserved = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -EINVAL);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, static_cast<agnocast_publish *>(kBadPtr)), -EFAULT);
+
+  Endpoint s1, s2, sp;
+  ASSERT_EQ(add_subscriber(dev, "/pe", 1, &s1), 0);
+  ASSERT_EQ(add_subscriber(dev, "/pe", 1, &s2), 0);
+  ASSERT_EQ(add_subscriber(dev, "/pe", 1, &sp, AGNOCAST_POLLING), 0);
+  uint32_t wake[2];
+  arg = poisoned<agnocast_publish>();
+  arg.topic_handle = pub.handle;
+  arg.publisher_id = pub.id;
+  arg.addr = reg.addr;
+  arg.bytes = 1;
+  arg.wake_ids = uptr(wake);
+  arg.wake_capacity = 1;
+  arg.reclaim = 0;
+  arg.reclaim_capacity = 0;
+  arg.reserved = 0;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -ENOBUFS);
+  arg.wake_ids = uptr(kBadPtr);
+  arg.wake_capacity = 2;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -EFAULT);
+  agnocast_topic_info info;
+  ASSERT_EQ(topic_info(dev, "/pe", &info), 0);
+  EXPECT_EQ(info.entries, 0u);  // failed publishes leave nothing
+  arg.wake_ids = uptr(wake);
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), 0);
+  EXPECT_EQ(arg.entry_id, 0u);
+  EXPECT_EQ(arg.wake_count, 2u);
+  EXPECT_EQ(arg.reclaim_count, 0u);
+  EXPECT_EQ(arg.reclaim_pending, 0u);
+  EXPECT_EQ(arg.reserved, 0u);
+  EXPECT_EQ(wake[0], s1.id);
+  EXPECT_EQ(wake[1], s2.id);
+}
+
+TEST_F(Device, Reclaim)
+{
+  registered();
+  Endpoint pub;
+  ASSERT_EQ(add_publisher(dev, "/rc", 1, &pub), 0);
+  PublishResult res;
+  for (int i = 0; i < 4; i++) ASSERT_EQ(publish(dev, pub, reg.addr + 8 * i, &res, 0), 0);
+  EXPECT_TRUE(res.reclaim.empty());
+  EXPECT_EQ(res.reclaim_pending, 3u);
+
+  auto rc = poisoned<agnocast_reclaim>();
+  rc.reserved = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), -EINVAL);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, static_cast<agnocast_reclaim *>(kBadPtr)), -EFAULT);
+  rc.reserved = 0;
+  rc.reclaim = uptr(kBadPtr);
+  rc.reclaim_capacity = 2;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), -EFAULT);  // loses nothing
+
+  uint64_t addrs[3];
+  std::memset(addrs, kPoison, sizeof(addrs));
+  rc = poisoned<agnocast_reclaim>();
+  rc.reclaim = uptr(addrs);
+  rc.reclaim_capacity = 2;
+  rc.reserved = 0;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), 0);
+  EXPECT_EQ(rc.reclaim_count, 2u);
+  EXPECT_EQ(rc.reclaim_pending, 1u);
+  EXPECT_EQ(rc.reserved, 0u);
+  EXPECT_EQ(addrs[0], reg.addr);
+  EXPECT_EQ(addrs[1], reg.addr + 8);
+  EXPECT_EQ(addrs[2], 0xA5A5A5A5A5A5A5A5ull);
+  rc.reclaim_capacity = 3;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), 0);
+  EXPECT_EQ(rc.reclaim_count, 1u);
+  EXPECT_EQ(rc.reclaim_pending, 0u);
+  EXPECT_EQ(addrs[0], reg.addr + 16);
+}
+
+TEST_F(Device, ReceiveErrors)
+{
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/re", 1, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/re", 4, &sub), 0);
+  ReceiveResult rr;
+  EXPECT_EQ(receive(dev, sub, &rr, 0, 1), -EINVAL);
+  EXPECT_EQ(receive(dev, sub, &rr, 1, 0), -EINVAL);
+  EXPECT_EQ(receive(dev, {sub.handle, pub.id}, &rr), -ENOENT);
+  EXPECT_EQ(receive(dev, {sub.handle + 1000, sub.id}, &rr), -ENOENT);
+  auto arg = poisoned<agnocast_receive>();
+  arg.topic_handle = sub.handle;
+  arg.subscriber_id = sub.id;
+  arg.entry_capacity = 1;
+  arg.pool_capacity = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, &arg), -EINVAL);  // reserved poisoned
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, static_cast<agnocast_receive *>(kBadPtr)), -EFAULT);
+
+  ASSERT_EQ(publish(dev, pub, reg.addr), 0);
+  arg.reserved = 0;
+  arg.entries = uptr(kBadPtr);
+  arg.pools = uptr(kBadPtr);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, &arg), -EFAULT);
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  ASSERT_EQ(topic_info(dev, "/re", &info, nullptr, &subs), 0);
+  EXPECT_EQ(subs[0].unreceived, 1u);  // a failed receive moved nothing
+  EXPECT_EQ(subs[0].held, 0u);
+}
+
+TEST_F(Device, TakeNewestPassesOverOlder)
+{
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/tk", 1, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/tk", 3, &sub, AGNOCAST_POLLING), 0);
+
+  auto take = poisoned<agnocast_take>();
+  take.topic_handle = sub.handle;
+  take.subscriber_id = sub.id;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), 0);
+  EXPECT_EQ(take.entry_count, 0u);
+  EXPECT_EQ(take.pool_count, 0u);
+  EXPECT_EQ(take.entry.entry_id, 0u);
+  EXPECT_EQ(take.entry.addr, 0u);
+  EXPECT_EQ(take.pool.fd, 0);
+
+  PublishResult res;
+  for (int i = 0; i < 3; i++) ASSERT_EQ(publish(dev, pub, reg.addr + 8 * i, &res), 0);
+  take = poisoned<agnocast_take>();
+  take.topic_handle = sub.handle;
+  take.subscriber_id = sub.id;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), 0);
+  EXPECT_EQ(take.entry_count, 1u);
+  EXPECT_EQ(take.entry.entry_id, 2u);
+  EXPECT_EQ(take.entry.addr, reg.addr + 16);
+  EXPECT_EQ(take.entry.reserved, 0u);
+  EXPECT_EQ(take.pool_count, 0u);
+
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  ASSERT_EQ(topic_info(dev, "/tk", &info, nullptr, &subs), 0);
+  EXPECT_EQ(subs[0].unreceived, 0u);
+  EXPECT_EQ(subs[0].held, 1u);
+  EXPECT_EQ(subs[0].dropped, 0u);  // passed over, not dropped
+  EXPECT_EQ(info.entries, 1u);
+
+  auto rc = poisoned<agnocast_reclaim>();
+  uint64_t addrs[4];
+  rc.reclaim = uptr(addrs);
+  rc.reclaim_capacity = 4;
+  rc.reserved = 0;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), 0);
+  EXPECT_EQ(rc.reclaim_count, 2u);
+
+  take.subscriber_id = pub.id;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -ENOENT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, static_cast<agnocast_take *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(release(dev, sub, 2), 0);
+}
+
+TEST_F(Device, TransientLocal)
+{
+  registered();
+  Endpoint tl_pub, pub, tl_sub, sub;
+  ASSERT_EQ(add_publisher(dev, "/tl", 3, &tl_pub, AGNOCAST_TRANSIENT_LOCAL), 0);
+  ASSERT_EQ(add_publisher(dev, "/tl", 3, &pub), 0);
+  for (int i = 0; i < 5; i++) {
+    ASSERT_EQ(publish(dev, tl_pub, reg.addr + 8 * i), 0);  // ids 0,2,4,6,8
+    ASSERT_EQ(publish(dev, pub, reg.addr + 1024 + 8 * i), 0);  // ids 1,3,5,7,9
+  }
+  ASSERT_EQ(add_subscriber(dev, "/tl", 2, &tl_sub, AGNOCAST_TRANSIENT_LOCAL), 0);
+  ASSERT_EQ(add_subscriber(dev, "/tl", 2, &sub), 0);
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, tl_sub, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 2u);
+  EXPECT_EQ(rr.entries[0].entry_id, 6u);
+  EXPECT_EQ(rr.entries[1].entry_id, 8u);
+  EXPECT_EQ(rr.entries[1].publisher_id, tl_pub.id);
+  ASSERT_EQ(receive(dev, sub, &rr), 0);
+  EXPECT_TRUE(rr.entries.empty());
+}
+
+TEST_F(Device, Introspection)
+{
+  registered();
+  Endpoint ep;
+  ASSERT_EQ(add_publisher(dev, "/zeta", 1, &ep), 0);
+  ASSERT_EQ(add_subscriber(dev, "/alpha", 1, &ep), 0);
+  ASSERT_EQ(add_subscriber(dev, "/alpha", 1, &ep), 0);
+
+  agnocast_topic_summary topics[4];
+  std::memset(topics, kPoison, sizeof(topics));
+  auto lt = poisoned<agnocast_list_topics>();
+  lt.topics = uptr(topics);
+  lt.capacity = 4;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
+  ASSERT_EQ(lt.total, 2u);
+  EXPECT_STREQ(topics[0].name, "/alpha");
+  EXPECT_EQ(topics[0].publishers, 0u);
+  EXPECT_EQ(topics[0].subscribers, 2u);
+  EXPECT_STREQ(topics[1].name, "/zeta");
+  EXPECT_EQ(topics[1].publishers, 1u);
+  EXPECT_EQ(static_cast<uint8_t>(topics[2].name[0]), kPoison);
+  lt.capacity = 1;
+  std::memset(topics, kPoison, sizeof(topics));
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
+  EXPECT_EQ(lt.total, 2u);
+  EXPECT_STREQ(topics[0].name, "/alpha");
+  EXPECT_EQ(static_cast<uint8_t>(topics[1].name[0]), kPoison);
+  lt.capacity = 0;
+  lt.topics = 0;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
+  EXPECT_EQ(lt.total, 2u);
+  lt.capacity = 2;
+  lt.topics = uptr(kBadPtr);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, static_cast<agnocast_list_topics *>(kBadPtr)),
+            -EFAULT);
+
+  agnocast_topic_info info;
+  EXPECT_EQ(topic_info(dev, "/nope", &info), -ENOENT);
+  EXPECT_EQ(topic_info(dev, "bad", &info), -EINVAL);
+  info = poisoned<agnocast_topic_info>();
+  std::strcpy(info.name, "/zeta");
+  info.publisher_capacity = 0;
+  info.subscriber_capacity = 0;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info), -EINVAL);  // reserved poisoned
+  info.reserved = 0;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info), 0);
+  EXPECT_EQ(info.publisher_total, 1u);
+  EXPECT_EQ(info.subscriber_total, 0u);
+  std::memset(info.name, 'z', sizeof(info.name));
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info), -EINVAL);
+
+  std::vector<agnocast_process_info> procs(8);
+  std::memset(procs.data(), kPoison, procs.size() * sizeof(procs[0]));
+  auto lp = poisoned<agnocast_list_processes>();
+  lp.processes = uptr(procs.data());
+  lp.capacity = 8;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &lp), 0);
+  bool found = false;
+  for (uint32_t i = 0; i < std::min(lp.total, 8u); i++) {
+    if (procs[i].pid != getpid()) continue;
+    found = true;
+    EXPECT_EQ(procs[i].publishers, 1u);
+    EXPECT_EQ(procs[i].subscribers, 2u);
+    EXPECT_EQ(procs[i].pools_mapped, 0u);
+    EXPECT_EQ(procs[i].pool_addr, reg.addr);
+    EXPECT_EQ(procs[i].pool_size, reg.size);
+  }
+  EXPECT_TRUE(found);
+  lp.processes = uptr(kBadPtr);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &lp), -EFAULT);
+  // Introspection needs no registration.
+  EXPECT_EQ(in_child([&] {
+              int d = open_device();
+              agnocast_list_topics l{0, 0, 0};
+              return ioc(d, AGNOCAST_IOC_LIST_TOPICS, &l) == 0 && l.total == 2 ? 0 : 1;
+            }),
+            0);
+}
+
+TEST_F(Device, ExitRecordsReadErrors)
+{
+  drain_exit_records(dev);
+  int fd = open_device(O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(fd, 0);
+  agnocast_exit_record rec[2];
+  EXPECT_EQ(read(fd, rec, sizeof(rec[0]) - 1), -1);
+  EXPECT_EQ(errno, EINVAL);
+  EXPECT_EQ(read(fd, rec, sizeof(rec)), -1);
+  EXPECT_EQ(errno, EAGAIN);
+
+  // A child that registers and dies leaves one PROCESS record.
+  pid_t child = fork();
+  if (child == 0) {
+    Registration r;
+    _exit(r.reserve(open_device()) ? 1 : 0);
+  }
+  int status;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  ASSERT_TRUE(eventually([&] { return !process_listed(dev, child); }));
+  std::memset(rec, kPoison, sizeof(rec));
+  ASSERT_EQ(read(fd, rec, sizeof(rec)), static_cast<ssize_t>(sizeof(rec[0])));
+  EXPECT_EQ(rec[0].kind, static_cast<uint32_t>(AGNOCAST_EXIT_PROCESS));
+  EXPECT_EQ(rec[0].pid, child);
+  EXPECT_EQ(rec[0].subscriber_id, 0u);
+  EXPECT_EQ(rec[0].reserved, 0u);
+  EXPECT_EQ(rec[0].topic[0], '\0');
+  EXPECT_EQ(static_cast<uint8_t>(rec[1].topic[0]), kPoison);
+
+  // Without CAP_SYS_ADMIN: -EPERM.
+  EXPECT_EQ(in_child([&] {
+              if (setuid(65534)) return 10;
+              agnocast_exit_record r;
+              return read(fd, &r, sizeof(r)) == -1 && errno == EPERM ? 0 : 11;
+            }),
+            0);
+  close(fd);
+}
+
+TEST_F(Device, ExitRecordsPollAndBlock)
+{
+  drain_exit_records(dev);
+  int fd = open_device(O_RDONLY);
+  struct pollfd pfd = {fd, POLLIN, 0};
+  EXPECT_EQ(poll(&pfd, 1, 0), 0);
+  pid_t child = fork();
+  if (child == 0) {
+    Registration r;
+    _exit(r.reserve(open_device()) ? 1 : 0);
+  }
+  EXPECT_EQ(poll(&pfd, 1, 10000), 1);
+  EXPECT_TRUE(pfd.revents & POLLIN);
+  agnocast_exit_record rec;
+  ASSERT_EQ(read(fd, &rec, sizeof(rec)), static_cast<ssize_t>(sizeof(rec)));  // blocking
+  EXPECT_EQ(rec.pid, child);
+  waitpid(child, nullptr, 0);
+  close(fd);
+}
+
+TEST_F(Device, MovedToAnotherIpcNamespaceIsExdev)
+{
+  EXPECT_EQ(in_child([&] {
+              Registration r;
+              if (r.reserve(dev)) return 10;
+              if (unshare(CLONE_NEWIPC)) return 11;
+              Endpoint ep;
+              if (add_publisher(dev, "/x", 1, &ep) != -EXDEV) return 12;
+              if (ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS) != -EXDEV) return 13;
+              return 0;
+            }),
+            0);
+}
+
+}  // namespace

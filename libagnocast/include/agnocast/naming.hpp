@@ -10,6 +10,12 @@
 
 namespace agnocast {
 
+// The notification a publisher sends to a subscriber's queue. Its content is
+// irrelevant: receiving it means "ask the kernel what there is to receive".
+struct MqMsgAgnocast {
+  bool dummy;
+};
+
 // Where the mqueue filesystem is mounted; a queue "/x@1" is the file "/dev/mqueue/x@1".
 inline constexpr std::string_view mqueue_directory = "/dev/mqueue";
 

@@ -1,0 +1,52 @@
+// How a message sits in the pool and how received entries are reference-counted.
+// Internal to the library's templates; not part of the public API.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace agnocast::detail {
+
+// Placed right before every loaned message, in the publisher's own pool.
+// Subscribers never write it; the publisher uses it to destroy the message
+// when the kernel reports it reclaimable, even after the Publisher is gone.
+struct MessageHeader {
+  void (*destroy)(void* message);
+  void* block;  // the pool allocation that holds header and message
+};
+
+template <class T>
+void destroy_message_object(void* message) {
+  static_cast<T*>(message)->~T();
+}
+
+// Pool memory for a message of size/align, header filled; returns the message address.
+void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*));
+// Frees memory from allocate_message whose object was never constructed.
+void free_message_memory(void* message) noexcept;
+// Destroys a constructed, unpublished message and frees its memory.
+void discard_message(void* message) noexcept;
+
+// Whoever must hear that a received entry is no longer referenced (the subscriber).
+class EntryOwner {
+ public:
+  virtual ~EntryOwner() = default;
+  virtual void release_entry(std::uint64_t entry_id) noexcept = 0;
+};
+
+// One received entry, shared by every ipc_shared_ptr copy that points to it.
+struct EntryReference {
+  std::atomic<std::uint32_t> count{1};
+  std::shared_ptr<EntryOwner> owner;
+  std::uint64_t entry_id = 0;
+};
+
+inline void retain(EntryReference* reference) noexcept {
+  reference->count.fetch_add(1, std::memory_order_relaxed);
+}
+// The last release tells the owner and frees the reference.
+void release(EntryReference* reference) noexcept;
+
+}  // namespace agnocast::detail

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <memory>
+#include <new>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+#include "agnocast/detail/endpoints.hpp"
+#include "agnocast/ipc_shared_ptr.hpp"
+
+namespace agnocast {
+
+template <class T>
+class Publisher {
+  static_assert(!std::is_polymorphic_v<T>,
+                "agnocast messages cannot have virtual functions: vtable addresses differ "
+                "between processes");
+  static_assert(!std::is_const_v<T>, "publish a non-const message type");
+
+ public:
+  Publisher(std::shared_ptr<detail::NodeState> node, std::string_view topic, const QoS& qos)
+      : core_(std::move(node), topic, qos) {}
+
+  // A default-constructed T in this process's shared pool, for you to fill in.
+  ipc_shared_ptr<T> borrow_loaned_message() {
+    void* memory =
+        detail::allocate_message(sizeof(T), alignof(T), &detail::destroy_message_object<T>);
+    T* message;
+    try {
+      message = new (memory) T();
+    } catch (...) {
+      detail::free_message_memory(memory);
+      throw;
+    }
+    return detail::MessageAccess::loan(message);
+  }
+
+  // Zero-copy: hands the loan to every subscriber. message is empty afterwards.
+  void publish(ipc_shared_ptr<T>&& message) {
+    T* loaned = detail::MessageAccess::release_loan(message);
+    if (!loaned) {
+      throw std::invalid_argument(
+          "agnocast: publish needs a message from borrow_loaned_message() not yet published");
+    }
+    core_.publish(loaned, sizeof(T));
+  }
+
+  const std::string& get_topic_name() const { return core_.topic(); }
+  std::uint32_t id() const { return core_.id(); }
+
+ private:
+  detail::PublisherCore core_;
+};
+
+}  // namespace agnocast

@@ -1,0 +1,116 @@
+#include "notification_queue.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+
+#include "agnocast/errors.hpp"
+#include "agnocast/naming.hpp"
+
+namespace agnocast::detail {
+namespace {
+
+constexpr std::size_t max_cached_senders = 256;
+
+std::string creation_advice(int err) {
+  switch (err) {
+    case ENOSPC:
+      return "the system-wide number of message queues is at fs.mqueue.queues_max; raise it "
+             "(sysctl fs.mqueue.queues_max=N)";
+    case EMFILE:
+      return "this process reached its limit on open descriptors (RLIMIT_NOFILE) or on queue "
+             "memory (RLIMIT_MSGQUEUE, ulimit -q); raise the limit";
+    case ENFILE:
+      return "the system-wide limit on open files was reached (fs.file-max)";
+    case EINVAL:
+      return "the queue size exceeds fs.mqueue.msg_max or fs.mqueue.msgsize_max; raise them "
+             "(sysctl fs.mqueue.msg_max=N)";
+    case ENAMETOOLONG:
+      return "the queue name exceeds NAME_MAX (255)";
+    case EACCES:
+      return "permission denied";
+    default:
+      return std::strerror(err);
+  }
+}
+
+}  // namespace
+
+long system_msg_max() {
+  std::ifstream file("/proc/sys/fs/mqueue/msg_max");
+  long value = 0;
+  if (file >> value && value > 0) return value;
+  return 10;  // the Linux default
+}
+
+OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
+    : name_(name), descriptor_(-1), owner_pid_(::getpid()) {
+  mq_attr attributes{};
+  attributes.mq_maxmsg = std::min(static_cast<long>(depth), system_msg_max());
+  attributes.mq_msgsize = sizeof(MqMsgAgnocast);
+  const int flags = O_RDONLY | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
+  // Mode 0666 lets publishers of any user notify us; the umask still applies.
+  descriptor_ = ::mq_open(name.c_str(), flags, 0666, &attributes);
+  if (descriptor_ == -1 && errno == EEXIST) {
+    // The kernel never gives a live subscriber's id twice for a name, so this
+    // queue is a leftover nobody owns: replace it.
+    ::mq_unlink(name.c_str());
+    descriptor_ = ::mq_open(name.c_str(), flags, 0666, &attributes);
+  }
+  if (descriptor_ == -1) {
+    const int err = errno;
+    throw QueueError(err, "agnocast: cannot create notification queue " + name + ": " +
+                              creation_advice(err) + " (" + std::strerror(err) + ")");
+  }
+}
+
+OwnedQueue::~OwnedQueue() {
+  ::mq_close(descriptor_);
+  // A fork child shares the descriptor but not the ownership.
+  if (::getpid() == owner_pid_) ::mq_unlink(name_.c_str());
+}
+
+void OwnedQueue::drain() const {
+  char buffer[sizeof(MqMsgAgnocast)];
+  while (::mq_receive(descriptor_, buffer, sizeof buffer, nullptr) >= 0 || errno == EINTR) {
+  }
+}
+
+void OwnedQueue::notify() const {
+  // Our own descriptor is read-only, as the seed prescribes: send through another.
+  const mqd_t sender = ::mq_open(name_.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+  if (sender == -1) return;
+  const MqMsgAgnocast message{};
+  ::mq_send(sender, reinterpret_cast<const char*>(&message), sizeof message, 0);
+  ::mq_close(sender);
+}
+
+QueueSenders::~QueueSenders() {
+  for (const auto& [id, descriptor] : descriptors_) ::mq_close(descriptor);
+}
+
+void QueueSenders::notify(std::uint32_t subscriber_id) {
+  auto found = descriptors_.find(subscriber_id);
+  if (found == descriptors_.end()) {
+    const mqd_t descriptor =
+        ::mq_open(queue_name(topic_, subscriber_id).c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (descriptor == -1) return;  // not created yet (ENOENT) or unusable: nothing to wake
+    // Ids of gone subscribers are never reused, so the cache only grows; bound it.
+    if (descriptors_.size() >= max_cached_senders) {
+      for (const auto& [id, cached] : descriptors_) ::mq_close(cached);
+      descriptors_.clear();
+    }
+    found = descriptors_.emplace(subscriber_id, descriptor).first;
+  }
+  const MqMsgAgnocast message{};
+  while (::mq_send(found->second, reinterpret_cast<const char*>(&message), sizeof message, 0) !=
+             0 &&
+         errno == EINTR) {
+  }
+}
+
+}  // namespace agnocast::detail

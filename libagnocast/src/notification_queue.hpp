@@ -1,0 +1,57 @@
+// The POSIX message queues that carry "something new for you" (SPEC §3).
+#pragma once
+
+#include <mqueue.h>
+#include <sys/types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+
+namespace agnocast::detail {
+
+// The receiving end a callback subscriber creates and owns; unlinked on destruction.
+class OwnedQueue {
+ public:
+  // Creates name for depth notifications (capped by fs.mqueue.msg_max),
+  // replacing a stale queue of that name. Throws QueueError naming the limit hit.
+  OwnedQueue(const std::string& name, std::size_t depth);
+  ~OwnedQueue();
+  OwnedQueue(const OwnedQueue&) = delete;
+  OwnedQueue& operator=(const OwnedQueue&) = delete;
+
+  int fd() const { return descriptor_; }
+  const std::string& name() const { return name_; }
+  // Empties the queue without blocking.
+  void drain() const;
+  // Queues one notification to ourselves (never blocks; a full queue is fine).
+  void notify() const;
+
+ private:
+  std::string name_;
+  mqd_t descriptor_;
+  pid_t owner_pid_;
+};
+
+// A publisher's sending ends, opened on first use and kept per subscriber id.
+class QueueSenders {
+ public:
+  explicit QueueSenders(std::string topic) : topic_(std::move(topic)) {}
+  ~QueueSenders();
+  QueueSenders(const QueueSenders&) = delete;
+  QueueSenders& operator=(const QueueSenders&) = delete;
+
+  // Never blocks and never throws: a full queue already holds a wake-up, and a
+  // queue not created yet is notified by its subscriber itself.
+  void notify(std::uint32_t subscriber_id);
+
+ private:
+  std::string topic_;
+  std::map<std::uint32_t, mqd_t> descriptors_;
+};
+
+// The system's fs.mqueue.msg_max (what an unprivileged queue may hold).
+long system_msg_max();
+
+}  // namespace agnocast::detail

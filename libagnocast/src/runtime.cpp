@@ -1,0 +1,246 @@
+#include "runtime.hpp"
+
+#include <fcntl.h>
+#include <pthread.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+#include <vector>
+
+#include "agnocast/allocator.hpp"
+#include "agnocast/detail/message.hpp"
+#include "agnocast/errors.hpp"
+
+namespace agnocast::detail {
+namespace {
+
+std::atomic<Runtime*> instance{nullptr};
+std::mutex init_mutex;
+
+std::string hex(std::uint64_t value) {
+  std::ostringstream out;
+  out << "0x" << std::hex << value;
+  return out.str();
+}
+
+[[noreturn]] void throw_errno(const std::string& what, int err) {
+  throw Error("agnocast: " + what + ": " + std::strerror(err));
+}
+
+// Maps fd at exactly addr, refusing to replace anything unless replace is set.
+void map_at(std::uint64_t addr, std::uint64_t size, int prot, int fd, bool replace,
+            const std::string& what) {
+  void* wanted = reinterpret_cast<void*>(addr);
+  const int flags = MAP_SHARED | (replace ? MAP_FIXED : MAP_FIXED_NOREPLACE);
+  void* mapped = ::mmap(wanted, size, prot, flags, fd, 0);
+  if (mapped == MAP_FAILED) {
+    const int err = errno;
+    throw Error("agnocast: cannot map " + what + " at " + hex(addr) + " (" + std::to_string(size) +
+                " bytes): " + std::strerror(err) +
+                (err == EEXIST ? "; something else occupies that address range" : ""));
+  }
+  if (mapped != wanted) {  // kernels before 4.17 treat MAP_FIXED_NOREPLACE as a hint
+    ::munmap(mapped, size);
+    throw Error("agnocast: cannot map " + what + " at " + hex(addr) +
+                ": the kernel placed it elsewhere");
+  }
+}
+
+}  // namespace
+
+Runtime::Runtime(std::optional<Device> device, pid_t pid, void* pool_addr, std::size_t pool_size)
+    : device_(std::move(device)),
+      pid_(pid),
+      pool_addr_(pool_addr),
+      pool_size_(pool_size),
+      pool_(pool_addr, pool_size) {}
+
+Runtime* Runtime::current() noexcept { return instance.load(std::memory_order_acquire); }
+
+Runtime& Runtime::get() {
+  if (Runtime* runtime = current()) return *runtime;
+  std::lock_guard lock(init_mutex);
+  if (Runtime* runtime = current()) return *runtime;
+  static std::once_flag fork_handler_installed;
+  std::call_once(fork_handler_installed, [] {
+    // Holding init_mutex across fork keeps the child from inheriting it locked.
+    ::pthread_atfork([] { init_mutex.lock(); }, [] { init_mutex.unlock(); },
+                     [] {
+                       init_mutex.unlock();
+                       forget_in_fork_child();
+                     });
+  });
+  Runtime* runtime = create();
+  instance.store(runtime, std::memory_order_release);
+  return *runtime;
+}
+
+Runtime* Runtime::create() {
+  Device device = Device::open();
+  const Version module = device.get_version();
+  if (!is_compatible(module)) {
+    throw VersionMismatch("agnocast kernel module version " + module.to_string() +
+                          " is incompatible with library version " +
+                          std::string(library_version_string) +
+                          " (major.minor must match): install matching versions and restart "
+                          "agnocastd");
+  }
+  const PoolSlot slot = device.register_process(-1);
+  // From here on, every failure undoes what was done so far.
+  int memfd = -1;
+  bool mapped = false;
+  try {
+    memfd = ::memfd_create("agnocast_pool", MFD_CLOEXEC);
+    if (memfd < 0) throw_errno("memfd_create for the shared pool", errno);
+    if (::ftruncate(memfd, static_cast<off_t>(slot.size)) != 0) {
+      throw_errno("sizing the shared pool to " + std::to_string(slot.size) + " bytes", errno);
+    }
+    map_at(slot.addr, slot.size, PROT_READ | PROT_WRITE, memfd, /*replace=*/false,
+           "this process's pool");
+    mapped = true;
+    device.register_process(memfd);
+    ::close(std::exchange(memfd, -1));  // the mapping keeps the file alive
+  } catch (...) {
+    if (mapped) ::munmap(reinterpret_cast<void*>(slot.addr), slot.size);
+    if (memfd >= 0) ::close(memfd);
+    try {
+      device.unregister_process();
+    } catch (const DeviceError&) {
+      // Nothing more to undo: closing the device drops the registration too.
+    }
+    throw;
+  }
+  return new Runtime(std::move(device), slot.pid, reinterpret_cast<void*>(slot.addr), slot.size);
+}
+
+Runtime& Runtime::install_for_testing(void* region, std::size_t size) {
+  std::lock_guard lock(init_mutex);
+  Runtime* runtime = new Runtime(std::nullopt, ::getpid(), region, size);
+  // Any earlier test runtime is leaked on purpose: pointers into it may survive.
+  instance.store(runtime, std::memory_order_release);
+  return *runtime;
+}
+
+// The child shares the parent's pool file: it must not allocate in it, nor
+// look like the parent to the kernel. Unmap everything and start afresh on
+// next use. The old object is leaked: its mutexes may be held by threads
+// that do not exist in the child.
+void Runtime::forget_in_fork_child() noexcept {
+  Runtime* runtime = instance.exchange(nullptr);
+  if (!runtime || !runtime->device_) return;
+  ::munmap(runtime->pool_addr_, runtime->pool_size_);
+  for (const auto& [addr, size] : runtime->mapped_pools_) {
+    ::munmap(reinterpret_cast<void*>(addr), size);
+  }
+  runtime->device_->close();
+}
+
+void* Runtime::allocate(std::size_t size, std::size_t align) {
+  for (int attempt = 0;; ++attempt) {
+    {
+      std::lock_guard lock(pool_mutex_);
+      if (void* ptr = pool_.allocate(size, align)) return ptr;
+    }
+    if (attempt == 1 || !device_) break;
+    reclaim_all();
+  }
+  throw PoolExhausted(
+      "agnocast: the shared pool of this process (" + std::to_string(pool_size_ >> 20) +
+      " MiB) has no room for " + std::to_string(size) +
+      " bytes: raise the module parameter pool_size (modprobe agnocast pool_size=BYTES, or "
+      "\"pool_size\" in /etc/agnocast/agnocastd.json), or hold fewer messages");
+}
+
+void Runtime::deallocate(void* ptr) noexcept {
+  if (!ptr || !pool_.owns(ptr)) return;  // never free into another process's pool
+  std::lock_guard lock(pool_mutex_);
+  pool_.free(ptr);
+}
+
+Tlsf::Stats Runtime::pool_stats() const {
+  std::lock_guard lock(pool_mutex_);
+  Tlsf::Stats stats;
+  pool_.check(&stats);
+  return stats;
+}
+
+void Runtime::free_reclaimed(std::span<const std::uint64_t> addresses) noexcept {
+  for (std::uint64_t address : addresses) {
+    void* message = reinterpret_cast<void*>(address);
+    if (!owns(message)) continue;
+    discard_message(message);
+  }
+}
+
+void Runtime::reclaim_all() {
+  std::vector<std::uint64_t> addresses(256);
+  for (;;) {
+    const ReclaimResult result = device_->reclaim(addresses);
+    free_reclaimed(std::span(addresses.data(), result.reclaim_count));
+    if (result.reclaim_pending == 0) break;
+  }
+}
+
+void Runtime::map_pool(const PoolGrant& grant) {
+  struct CloseOnExit {
+    int fd;
+    ~CloseOnExit() { ::close(fd); }
+  } close_fd{grant.fd};
+  if (grant.addr == reinterpret_cast<std::uint64_t>(pool_addr_)) return;  // our own pool
+  std::lock_guard lock(mapped_mutex_);
+  // A slot freed by a dead publisher comes back with a new pool: replace our old view.
+  const bool replace = mapped_pools_.contains(grant.addr);
+  map_at(grant.addr, grant.size, PROT_READ, grant.fd, replace,
+         "the pool of publisher pid " + std::to_string(grant.pid));
+  mapped_pools_[grant.addr] = grant.size;
+}
+
+// The message functions of detail/message.hpp and allocator.hpp, over the runtime.
+
+void* pool_allocate(std::size_t bytes, std::size_t align) {
+  return Runtime::get().allocate(bytes, align);
+}
+
+void pool_deallocate(void* ptr) noexcept {
+  if (Runtime* runtime = Runtime::current()) runtime->deallocate(ptr);
+}
+
+namespace {
+
+constexpr std::size_t header_room = sizeof(MessageHeader);
+static_assert(header_room == Tlsf::alignment);
+
+MessageHeader* header_of(void* message) {
+  return reinterpret_cast<MessageHeader*>(static_cast<char*>(message) - header_room);
+}
+
+}  // namespace
+
+void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*)) {
+  align = std::max(align, Tlsf::alignment);
+  const std::size_t offset = (header_room + align - 1) & ~(align - 1);  // keeps message aligned
+  void* block = Runtime::get().allocate(offset + size, align);
+  void* message = static_cast<char*>(block) + offset;
+  *header_of(message) = MessageHeader{destroy, block};
+  return message;
+}
+
+void free_message_memory(void* message) noexcept { pool_deallocate(header_of(message)->block); }
+
+void discard_message(void* message) noexcept {
+  const MessageHeader header = *header_of(message);
+  header.destroy(message);
+  pool_deallocate(header.block);
+}
+
+void release(EntryReference* reference) noexcept {
+  if (reference->count.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+  reference->owner->release_entry(reference->entry_id);
+  delete reference;
+}
+
+}  // namespace agnocast::detail

@@ -1,0 +1,63 @@
+// The process's agnocast state: the device, its registration, its own
+// writable pool with the allocator over it, and the publisher pools it has
+// mapped read-only. Created lazily on first use, reset in a fork child.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <span>
+
+#include "device.hpp"
+#include "tlsf.hpp"
+
+namespace agnocast::detail {
+
+class Runtime {
+ public:
+  // The process's runtime, initialized on first call (throws what init throws).
+  static Runtime& get();
+  // The runtime if this process has one already, else nullptr; never initializes.
+  static Runtime* current() noexcept;
+  // A runtime over a caller-provided region and no device, for native tests.
+  static Runtime& install_for_testing(void* region, std::size_t size);
+
+  const Device& device() const { return *device_; }
+  pid_t pid() const { return pid_; }
+
+  // Throws PoolExhausted after a reclaim round could not make room.
+  void* allocate(std::size_t size, std::size_t align);
+  void deallocate(void* ptr) noexcept;
+  bool owns(const void* ptr) const { return pool_.owns(ptr); }
+  Tlsf::Stats pool_stats() const;
+
+  // Destroys and frees messages the kernel reported as no longer referenced.
+  void free_reclaimed(std::span<const std::uint64_t> addresses) noexcept;
+  // Asks the kernel for every reclaimable message of this process and frees it.
+  void reclaim_all();
+
+  // Maps a publisher's pool read-only at its address and closes grant.fd.
+  void map_pool(const PoolGrant& grant);
+
+ private:
+  Runtime(std::optional<Device> device, pid_t pid, void* pool_addr, std::size_t pool_size);
+  static Runtime* create();
+  static void forget_in_fork_child() noexcept;
+
+  std::optional<Device> device_;  // absent only in native tests
+  pid_t pid_;
+  void* pool_addr_;
+  std::size_t pool_size_;
+
+  mutable std::mutex pool_mutex_;
+  Tlsf pool_;
+
+  std::mutex mapped_mutex_;
+  std::map<std::uint64_t, std::uint64_t> mapped_pools_;  // address -> size
+};
+
+}  // namespace agnocast::detail

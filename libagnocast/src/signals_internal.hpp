@@ -1,0 +1,8 @@
+#pragma once
+
+namespace agnocast::detail {
+
+// Readable (level-triggered, never drained) once SIGINT or SIGTERM arrived.
+int shutdown_eventfd();
+
+}  // namespace agnocast::detail

@@ -1,0 +1,179 @@
+#include <array>
+#include <atomic>
+#include <exception>
+#include <mutex>
+
+#include "agnocast/detail/endpoints.hpp"
+#include "agnocast/errors.hpp"
+#include "agnocast/naming.hpp"
+#include "node_state.hpp"
+#include "notification_queue.hpp"
+#include "runtime.hpp"
+
+namespace agnocast::detail {
+namespace {
+
+// The kernel subscriber. It outlives its Subscription while any received
+// message is still held, so that memory is never reclaimed under a reader.
+class SubscriberEndpoint : public EntryOwner {
+ public:
+  SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
+      : runtime_(runtime), id_(runtime.device().add_subscriber(request)) {}
+
+  ~SubscriberEndpoint() override {
+    if (!still_ours()) return;
+    try {
+      runtime_.device().remove_subscriber(id_);
+    } catch (const Error&) {
+      // Destructors cannot report; the kernel drops everything at process exit.
+    }
+  }
+
+  void release_entry(std::uint64_t entry_id) noexcept override {
+    if (!still_ours()) return;
+    try {
+      runtime_.device().release(id_, entry_id);
+    } catch (const Error&) {
+      // As above: nothing useful to do with it here.
+    }
+  }
+
+  EntryReference* reference_to(std::uint64_t entry_id, std::shared_ptr<EntryOwner> self) {
+    auto* reference = new EntryReference;
+    reference->owner = std::move(self);
+    reference->entry_id = entry_id;
+    return reference;
+  }
+
+  Runtime& runtime() const { return runtime_; }
+  EndpointId id() const { return id_; }
+
+ private:
+  // False in a fork child: the endpoint and its references are the parent's.
+  bool still_ours() const { return Runtime::current() == &runtime_; }
+
+  Runtime& runtime_;
+  const EndpointId id_;
+};
+
+std::atomic<std::uint64_t> next_subscription_key{1};
+
+// Maps every granted pool (closing each descriptor) and throws the first failure.
+void map_pools(Runtime& runtime, std::span<const PoolGrant> pools) {
+  std::exception_ptr failure;
+  for (const PoolGrant& pool : pools) {
+    try {
+      runtime.map_pool(pool);
+    } catch (...) {
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace
+
+struct SubscriptionBase::State {
+  std::shared_ptr<NodeState> node;
+  std::string topic;
+  std::shared_ptr<SubscriberEndpoint> endpoint;
+  std::unique_ptr<OwnedQueue> queue;
+  std::uint64_t key = 0;
+  std::mutex receive_mutex;
+};
+
+SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic,
+                                   const QoS& qos)
+    : state_(std::make_unique<State>()) {
+  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/false);
+  state_->node = std::move(node);
+  state_->topic = request.topic;
+  state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
+  // If the queue cannot be created, the endpoint's destructor removes the subscriber.
+  state_->queue = std::make_unique<OwnedQueue>(
+      agnocast::queue_name(topic, state_->endpoint->id().id), qos.depth());
+  // Entries published before the queue existed woke nobody: wake ourselves.
+  state_->queue->notify();
+  state_->key = next_subscription_key.fetch_add(1);
+}
+
+SubscriptionBase::~SubscriptionBase() {
+  state_->node->remove_subscription(state_->key);
+  state_->endpoint.reset();  // removes the kernel subscriber unless messages are still held
+  state_->queue.reset();     // then unlinks the queue
+}
+
+const std::string& SubscriptionBase::topic() const { return state_->topic; }
+std::uint32_t SubscriptionBase::id() const { return state_->endpoint->id().id; }
+const std::string& SubscriptionBase::queue_name() const { return state_->queue->name(); }
+int SubscriptionBase::queue_fd() const { return state_->queue->fd(); }
+std::uint64_t SubscriptionBase::key() const { return state_->key; }
+
+std::size_t SubscriptionBase::handle_wakeup() {
+  State& state = *state_;
+  std::lock_guard lock(state.receive_mutex);
+  Runtime& runtime = state.endpoint->runtime();
+  state.queue->drain();
+  std::array<ReceivedEntry, 32> entries;
+  std::array<PoolGrant, 8> pools;
+  std::size_t delivered = 0;
+  for (;;) {
+    const ReceiveResult result = runtime.device().receive(state.endpoint->id(), entries, pools);
+    std::vector<EntryReference*> references;
+    for (std::uint32_t i = 0; i < result.entry_count; ++i) {
+      references.push_back(state.endpoint->reference_to(entries[i].entry_id, state.endpoint));
+    }
+    std::size_t handed_out = 0;  // deliver() owns every reference it was given
+    try {
+      map_pools(runtime, std::span(pools.data(), result.pool_count));
+      while (handed_out < references.size()) {
+        const std::size_t i = handed_out++;
+        deliver(reinterpret_cast<const void*>(entries[i].addr), references[i]);
+        ++delivered;
+      }
+    } catch (...) {
+      for (std::size_t i = handed_out; i < references.size(); ++i) release(references[i]);
+      throw;
+    }
+    if (result.remaining == 0) break;
+  }
+  return delivered;
+}
+
+struct PollingCore::State {
+  std::shared_ptr<NodeState> node;
+  std::string topic;
+  std::shared_ptr<SubscriberEndpoint> endpoint;
+};
+
+PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos)
+    : state_(std::make_unique<State>()) {
+  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/true);
+  state_->node = std::move(node);
+  state_->topic = request.topic;
+  state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
+}
+
+PollingCore::~PollingCore() = default;
+
+const std::string& PollingCore::topic() const { return state_->topic; }
+std::uint32_t PollingCore::id() const { return state_->endpoint->id().id; }
+
+TakenEntry PollingCore::take() {
+  SubscriberEndpoint& endpoint = *state_->endpoint;
+  const TakeResult taken = endpoint.runtime().device().take(endpoint.id());
+  EntryReference* reference =
+      taken.has_entry ? endpoint.reference_to(taken.entry.entry_id, state_->endpoint) : nullptr;
+  if (taken.has_pool) {
+    try {
+      endpoint.runtime().map_pool(taken.pool);
+    } catch (...) {
+      if (reference) release(reference);
+      throw;
+    }
+  }
+  if (!reference) return {};
+  return TakenEntry{reinterpret_cast<const void*>(taken.entry.addr), reference};
+}
+
+}  // namespace agnocast::detail

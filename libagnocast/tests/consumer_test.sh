@@ -1,0 +1,24 @@
+#!/bin/sh
+# Installs the library from the build tree into a scratch prefix, then builds
+# and runs a tiny consumer with find_package and with pkg-config.
+# usage: consumer_test.sh BUILD_DIR CONSUMER_SOURCE_DIR SCRATCH_DIR
+set -eu
+build=$1 source=$2 scratch=$3
+rm -rf "$scratch"
+mkdir -p "$scratch"
+prefix=$scratch/prefix
+
+cmake --install "$build" --prefix "$prefix" --component agnocast_library >/dev/null
+
+cmake -S "$source" -B "$scratch/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+cmake --build "$scratch/cmake-build" >/dev/null
+libdir=$(dirname "$(find "$prefix" -name 'libagnocast.so' | head -n1)")
+LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/consumer" | grep -q '^agnocast '
+
+pcdir=$(dirname "$(find "$prefix" -name agnocast.pc | head -n1)")
+export PKG_CONFIG_PATH=$pcdir
+test "$(pkg-config --modversion agnocast)" = "$(LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/consumer" | cut -d' ' -f2)"
+# shellcheck disable=SC2046 # pkg-config output is meant to be split
+c++ -std=c++20 -o "$scratch/consumer-pc" "$source/main.cpp" $(pkg-config --cflags --libs agnocast)
+LD_LIBRARY_PATH=$libdir "$scratch/consumer-pc" | grep -q '^agnocast '
+echo "consumer builds with find_package and pkg-config"

@@ -1,0 +1,63 @@
+#include "cleaner.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <charconv>
+
+namespace agnocastd {
+
+namespace {
+constexpr std::string_view pool_prefix = "agnocast@";
+}
+
+std::string pool_object_name(pid_t pid) { return std::string(pool_prefix) + std::to_string(pid); }
+
+std::optional<pid_t> parse_pool_object_name(const std::string& file) {
+  if (!file.starts_with(pool_prefix)) return std::nullopt;
+  const std::string_view digits = std::string_view(file).substr(pool_prefix.size());
+  if (digits.empty() || digits.front() == '0') return std::nullopt;
+  pid_t pid = 0;
+  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
+  if (error != std::errc{} || end != digits.data() + digits.size() || pid <= 0) {
+    return std::nullopt;
+  }
+  return pid;
+}
+
+std::vector<DeadProcess> DeadProcessCollector::add(
+    const std::vector<agnocast::ExitRecord>& records) {
+  std::vector<DeadProcess> dead;
+  for (const auto& record : records) {
+    if (record.kind == agnocast::ExitRecord::Kind::queue) {
+      pending_queues_[record.pid].push_back(record.queue());
+      continue;
+    }
+    DeadProcess process{record.pid, {}};
+    if (const auto pending = pending_queues_.find(record.pid); pending != pending_queues_.end()) {
+      process.queues = std::move(pending->second);
+      pending_queues_.erase(pending);
+    }
+    dead.push_back(std::move(process));
+  }
+  return dead;
+}
+
+void clean_dead_process(const DeadProcess& process, Host& host, Counters& counters) {
+  for (const auto& queue : process.queues) {
+    if (host.remove_queue(queue)) {
+      ++counters.queues_removed;
+      spdlog::info("removed queue {} of dead process {}", queue, process.pid);
+    }
+  }
+  // A recycled pid may already belong to a new process that owns this object.
+  const std::string pool = pool_object_name(process.pid);
+  if (!host.process_alive(process.pid) && host.remove_shm(pool)) {
+    ++counters.shm_removed;
+    spdlog::info("removed shared memory /dev/shm/{} of dead process {}", pool, process.pid);
+  }
+  ++counters.processes_cleaned;
+  spdlog::info("cleaned up after dead process {} ({} queue(s))", process.pid,
+               process.queues.size());
+}
+
+}  // namespace agnocastd

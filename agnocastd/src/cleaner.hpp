@@ -1,0 +1,45 @@
+// Cleanup after a dead agnocast process, from the exit records the kernel
+// module queues for it.
+#pragma once
+
+#include <sys/types.h>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "agnocast/supervise.hpp"
+#include "counters.hpp"
+#include "host.hpp"
+
+namespace agnocastd {
+
+// "agnocast@<pid>": the /dev/shm file name of a process's pool, kept for
+// pools that older tools created as named objects (the kernel now hands out
+// memfds, which vanish by themselves).
+std::string pool_object_name(pid_t pid);
+// The pid of a pool object file name, nullopt for any other name.
+std::optional<pid_t> parse_pool_object_name(const std::string& file);
+
+struct DeadProcess {
+  pid_t pid = 0;
+  std::vector<std::string> queues;  // e.g. "/chatter@1"
+};
+
+// Turns the record stream into whole dead processes: a process's queue
+// records come before its process record, possibly in an earlier read.
+class DeadProcessCollector {
+ public:
+  std::vector<DeadProcess> add(const std::vector<agnocast::ExitRecord>& records);
+
+ private:
+  std::map<pid_t, std::vector<std::string>> pending_queues_;
+};
+
+// Removes what one dead process left, always in this order: its queues (no
+// publisher can wake a dead subscriber any more), then its pool object, then
+// it is counted.
+void clean_dead_process(const DeadProcess& process, Host& host, Counters& counters);
+
+}  // namespace agnocastd

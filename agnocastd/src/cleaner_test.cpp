@@ -1,0 +1,70 @@
+#include "cleaner.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "fake_host.hpp"
+
+namespace agnocastd {
+namespace {
+
+using agnocast::ExitRecord;
+using ::testing::ElementsAre;
+using ::testing::IsEmpty;
+
+ExitRecord queue_record(pid_t pid, std::string topic, std::uint32_t id) {
+  return {ExitRecord::Kind::queue, pid, std::move(topic), id};
+}
+ExitRecord process_record(pid_t pid) { return {ExitRecord::Kind::process, pid, {}, 0}; }
+
+TEST(PoolObjectName, RoundTrips) {
+  EXPECT_EQ(pool_object_name(1234), "agnocast@1234");
+  EXPECT_EQ(parse_pool_object_name("agnocast@1234"), 1234);
+  EXPECT_EQ(parse_pool_object_name("agnocast@"), std::nullopt);
+  EXPECT_EQ(parse_pool_object_name("agnocast@012"), std::nullopt);
+  EXPECT_EQ(parse_pool_object_name("agnocast@12x"), std::nullopt);
+  EXPECT_EQ(parse_pool_object_name("agnocast@99999999999"), std::nullopt);
+  EXPECT_EQ(parse_pool_object_name("chatter@1"), std::nullopt);
+}
+
+TEST(DeadProcessCollector, GroupsQueuesWithTheirProcess) {
+  DeadProcessCollector collector;
+  const auto dead = collector.add({queue_record(10, "/a/b", 1), queue_record(11, "/c", 0),
+                                   queue_record(10, "/c", 2), process_record(10)});
+  ASSERT_EQ(dead.size(), 1u);
+  EXPECT_EQ(dead[0].pid, 10);
+  EXPECT_THAT(dead[0].queues, ElementsAre("/a_b@1", "/c@2"));
+  // Process 11's records were split across two reads.
+  const auto later = collector.add({process_record(11), process_record(12)});
+  ASSERT_EQ(later.size(), 2u);
+  EXPECT_THAT(later[0].queues, ElementsAre("/c@0"));
+  EXPECT_THAT(later[1].queues, IsEmpty());
+}
+
+TEST(CleanDeadProcess, RemovesQueuesThenPoolThenCounts) {
+  FakeHost host;
+  host.queues = {"chatter@1", "chatter@2"};
+  host.shm = {"agnocast@77"};
+  Counters counters;
+  clean_dead_process({77, {"/chatter@1", "/gone@5"}}, host, counters);
+  EXPECT_THAT(host.calls, ElementsAre("remove_queue /chatter@1", "remove_queue /gone@5",
+                                      "remove_shm agnocast@77"));
+  EXPECT_EQ(host.queues, std::set<std::string>{"chatter@2"});
+  EXPECT_EQ(counters.queues_removed, 1u);  // /gone@5 was not there
+  EXPECT_EQ(counters.shm_removed, 1u);
+  EXPECT_EQ(counters.processes_cleaned, 1u);
+}
+
+TEST(CleanDeadProcess, LeavesThePoolObjectOfARecycledPid) {
+  FakeHost host;
+  host.shm = {"agnocast@77"};
+  host.alive = {77};
+  Counters counters;
+  clean_dead_process({77, {}}, host, counters);
+  EXPECT_EQ(host.shm.size(), 1u);
+  EXPECT_EQ(counters.shm_removed, 0u);
+  EXPECT_EQ(counters.processes_cleaned, 1u);
+}
+
+}  // namespace
+}  // namespace agnocastd

@@ -1,0 +1,47 @@
+// An in-memory Host for the cleaner and sweeper tests.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "host.hpp"
+
+namespace agnocastd {
+
+class FakeHost final : public Host {
+ public:
+  std::set<std::string> queues;  // file names in /dev/mqueue, "x@1"
+  std::set<std::string> live;    // queue names, "/x@1"
+  std::set<std::string> shm;     // file names in /dev/shm
+  std::set<pid_t> alive;
+  bool kernel_unreachable = false;
+  std::vector<std::string> calls;               // the order of OS work, for order checks
+  std::function<void()> between_list_and_live;  // runs after queue_files()
+
+  std::vector<std::string> queue_files() override {
+    calls.push_back("queue_files");
+    std::vector<std::string> listed(queues.begin(), queues.end());
+    if (between_list_and_live) between_list_and_live();
+    return listed;
+  }
+  std::set<std::string> live_queues() override {
+    calls.push_back("live_queues");
+    if (kernel_unreachable) throw std::runtime_error("/dev/agnocast is gone");
+    return live;
+  }
+  bool remove_queue(const std::string& name) override {
+    calls.push_back("remove_queue " + name);
+    return queues.erase(name.substr(1)) > 0;
+  }
+  std::vector<std::string> shm_files() override { return {shm.begin(), shm.end()}; }
+  bool process_alive(pid_t pid) override { return alive.contains(pid); }
+  bool remove_shm(const std::string& file) override {
+    calls.push_back("remove_shm " + file);
+    return shm.erase(file) > 0;
+  }
+};
+
+}  // namespace agnocastd

@@ -1,0 +1,70 @@
+#include "host.hpp"
+
+#include <dirent.h>
+#include <mqueue.h>
+#include <signal.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <memory>
+
+#include "agnocast/inspect.hpp"
+#include "agnocast/naming.hpp"
+
+namespace agnocastd {
+namespace {
+
+std::vector<std::string> list_directory(const std::string& path) {
+  std::vector<std::string> names;
+  const std::unique_ptr<DIR, int (*)(DIR*)> dir(::opendir(path.c_str()), ::closedir);
+  if (!dir) {
+    spdlog::warn("cannot list {}: {}", path, std::strerror(errno));
+    return names;
+  }
+  while (const dirent* entry = ::readdir(dir.get())) {
+    const std::string name = entry->d_name;
+    if (name != "." && name != "..") names.push_back(name);
+  }
+  return names;
+}
+
+bool removed(int result, const std::string& what) {
+  if (result == 0) return true;
+  if (errno != ENOENT) spdlog::warn("cannot remove {}: {}", what, std::strerror(errno));
+  return false;
+}
+
+}  // namespace
+
+std::vector<std::string> SystemHost::queue_files() {
+  return list_directory(std::string(agnocast::mqueue_directory));
+}
+
+std::set<std::string> SystemHost::live_queues() {
+  std::set<std::string> queues;
+  for (const auto& topic : agnocast::list_topics()) {
+    const auto info = agnocast::topic_info(topic.name);
+    if (!info) continue;  // its last endpoint left since list_topics
+    for (const auto& subscriber : info->subscribers) {
+      if (!subscriber.polling) queues.insert(agnocast::queue_name(info->name, subscriber.id));
+    }
+  }
+  return queues;
+}
+
+bool SystemHost::remove_queue(const std::string& name) {
+  return removed(::mq_unlink(name.c_str()), "queue " + name);
+}
+
+std::vector<std::string> SystemHost::shm_files() { return list_directory("/dev/shm"); }
+
+bool SystemHost::process_alive(pid_t pid) { return ::kill(pid, 0) == 0 || errno != ESRCH; }
+
+bool SystemHost::remove_shm(const std::string& file) {
+  const std::string path = "/dev/shm/" + file;
+  return removed(::unlink(path.c_str()), path);
+}
+
+}  // namespace agnocastd

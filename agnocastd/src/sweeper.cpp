@@ -1,0 +1,60 @@
+#include "sweeper.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+
+#include "agnocast/naming.hpp"
+#include "cleaner.hpp"
+
+namespace agnocastd {
+
+std::vector<std::string> stale_queues(const std::vector<std::string>& listed_files,
+                                      const std::set<std::string>& live_queues) {
+  std::vector<std::string> stale;
+  for (const auto& file : listed_files) {
+    if (!agnocast::parse_queue_name(file)) continue;
+    const std::string name = "/" + file;
+    if (!live_queues.contains(name)) stale.push_back(name);
+  }
+  return stale;
+}
+
+namespace {
+
+void sweep_queues(Host& host, Counters& counters) {
+  const auto listed = host.queue_files();
+  std::set<std::string> live;
+  try {
+    live = host.live_queues();
+  } catch (const std::exception& error) {
+    spdlog::error("sweep skipped: cannot read the live subscribers: {}", error.what());
+    return;
+  }
+  for (const auto& queue : stale_queues(listed, live)) {
+    if (host.remove_queue(queue)) {
+      ++counters.queues_removed;
+      spdlog::info("removed stale queue {} (no live subscriber owns it)", queue);
+    }
+  }
+}
+
+void sweep_pool_objects(Host& host, Counters& counters) {
+  for (const auto& file : host.shm_files()) {
+    const auto pid = parse_pool_object_name(file);
+    if (!pid || host.process_alive(*pid)) continue;
+    if (host.remove_shm(file)) {
+      ++counters.shm_removed;
+      spdlog::info("removed stale shared memory /dev/shm/{} (process {} is gone)", file, *pid);
+    }
+  }
+}
+
+}  // namespace
+
+void sweep(Host& host, Counters& counters) {
+  sweep_queues(host, counters);
+  sweep_pool_objects(host, counters);
+}
+
+}  // namespace agnocastd

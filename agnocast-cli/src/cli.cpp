@@ -1,0 +1,85 @@
+#include "cli.hpp"
+
+#include <algorithm>
+#include <exception>
+#include <string_view>
+
+#include "agnocast/errors.hpp"
+#include "commands.hpp"
+
+namespace agnocast::cli {
+namespace {
+
+// With --json a failure still prints exactly one object on stdout, so scripts
+// can always parse it; the message goes to stderr as well for people.
+int fail(int code, const std::string& message, bool json, std::ostream& out, std::ostream& err) {
+  err << "agnocast-cli: " << message << '\n';
+  if (json) out << nlohmann::json{{"error", message}, {"exit_code", code}}.dump() << '\n';
+  return code;
+}
+
+// --json is known before parsing finishes, so usage errors honour it too.
+bool wants_json(int argc, const char* const* argv) {
+  return std::any_of(argv + 1, argv + argc,
+                     [](const char* arg) { return std::string_view(arg) == "--json"; });
+}
+
+int run_chosen(const Command& command, bool json, std::ostream& out, std::ostream& err) {
+  const nlohmann::json value = command.build();
+  if (json) {
+    out << value.dump() << '\n';
+  } else {
+    out << command.render(value);
+  }
+  if (command.advice) {
+    if (const std::string advice = command.advice(value); !advice.empty()) err << advice << '\n';
+  }
+  return command.exit_code ? command.exit_code(value) : exit_success;
+}
+
+}  // namespace
+
+void add_json_flag(CLI::App& app, Context& context) {
+  app.add_flag("--json", context.json, "Print exactly one JSON object instead of a table");
+}
+
+void bind_command(CLI::App& sub, Context& context, Command command) {
+  add_json_flag(sub, context);
+  sub.callback([&context, command = std::move(command)] { context.chosen = command; });
+}
+
+int run_cli(int argc, const char* const* argv, InspectionSource& source, std::ostream& out,
+            std::ostream& err) {
+  Context context{source, false, std::nullopt};
+  CLI::App app{"agnocast-cli: inspect agnocast topics, queues, nodes and the daemon",
+               "agnocast-cli"};
+  app.require_subcommand(1);
+  add_json_flag(app, context);
+  set_topic_command(app, context);
+  set_queue_command(app, context);
+  set_node_command(app, context);
+  set_daemon_command(app, context);
+  set_doctor_command(app, context);
+  set_version_command(app, context);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help
+    return app.exit(e, out, err);
+  } catch (const CLI::ParseError& e) {
+    return fail(exit_usage_error, e.what() + std::string("; see --help"), wants_json(argc, argv),
+                out, err);
+  }
+  if (!context.chosen) {
+    return fail(exit_usage_error, "no command given; see --help", context.json, out, err);
+  }
+
+  try {
+    return run_chosen(*context.chosen, context.json, out, err);
+  } catch (const std::exception& e) {
+    // ModuleNotLoaded and the CLI's own errors already name the fix.
+    return fail(exit_runtime_error, e.what(), context.json, out, err);
+  }
+}
+
+}  // namespace agnocast::cli

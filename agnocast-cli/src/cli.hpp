@@ -1,0 +1,52 @@
+// The command-line front: parses, runs the chosen command, renders its value,
+// and turns every failure into the exit codes SPEC §6 fixes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "inspection_source.hpp"
+
+namespace agnocast::cli {
+
+inline constexpr int exit_success = 0;
+inline constexpr int exit_runtime_error = 1;
+inline constexpr int exit_usage_error = 2;
+
+// A runtime failure the CLI itself detects; the message says what and how to fix it.
+class CliError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// One runnable command: build its value, render it for humans, derive its exit code.
+struct Command {
+  std::function<nlohmann::json()> build = {};
+  std::function<std::string(const nlohmann::json&)> render = {};
+  // Exit code from the value (doctor fails when a check fails); nullptr means 0.
+  std::function<int(const nlohmann::json&)> exit_code = {};
+  // A line for stderr derived from the value (a hint), empty for none; may be nullptr.
+  std::function<std::string(const nlohmann::json&)> advice = {};
+};
+
+// Shared by every subcommand while the command line is parsed.
+struct Context {
+  InspectionSource& source;
+  bool json = false;
+  std::optional<Command> chosen;
+};
+
+// Gives `sub` its own --json flag and makes it the command that runs when chosen.
+void bind_command(CLI::App& sub, Context& context, Command command);
+void add_json_flag(CLI::App& app, Context& context);
+
+// The whole CLI; main() passes the real system, tests a fake. Returns the exit code.
+int run_cli(int argc, const char* const* argv, InspectionSource& source, std::ostream& out,
+            std::ostream& err);
+
+}  // namespace agnocast::cli

@@ -1,0 +1,148 @@
+// run_cli end to end against a fake system: output forms and exit codes.
+#include "cli.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "fake_source.hpp"
+
+namespace agnocast::cli {
+namespace {
+
+struct Outcome {
+  int code;
+  std::string out;
+  std::string err;
+};
+
+Outcome run(FakeSource& source, std::vector<const char*> args) {
+  args.insert(args.begin(), "agnocast-cli");
+  std::ostringstream out, err;
+  const int code = run_cli(static_cast<int>(args.size()), args.data(), source, out, err);
+  return {code, out.str(), err.str()};
+}
+
+TEST(Cli, TableByDefault) {
+  FakeSource source = healthy_system();
+  const Outcome r = run(source, {"topic", "list"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("NAME", 0), 0u);
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(Cli, JsonGlobalOrPerSubcommandPrintsExactlyOneObject) {
+  for (auto args : {std::vector<const char*>{"--json", "topic", "list"},
+                    std::vector<const char*>{"topic", "list", "--json"}}) {
+    FakeSource source = healthy_system();
+    const Outcome r = run(source, args);
+    EXPECT_EQ(r.code, 0);
+    ASSERT_FALSE(r.out.empty());
+    EXPECT_EQ(r.out.back(), '\n');
+    EXPECT_EQ(r.out.find('\n'), r.out.size() - 1);  // one line: one object
+    EXPECT_TRUE(nlohmann::json::parse(r.out).contains("topics"));
+  }
+}
+
+TEST(Cli, EveryCommandRunsOnAHealthySystem) {
+  const std::vector<std::vector<const char*>> commands = {{"topic", "list"},
+                                                          {"topic", "info", "/chatter"},
+                                                          {"topic", "hz", "/chatter"},
+                                                          {"queue", "list"},
+                                                          {"node", "list"},
+                                                          {"daemon", "status"},
+                                                          {"doctor"},
+                                                          {"version"}};
+  for (const auto& command : commands) {
+    for (bool json : {false, true}) {
+      FakeSource source = healthy_system();
+      auto args = command;
+      if (json) args.push_back("--json");
+      const Outcome r = run(source, args);
+      EXPECT_EQ(r.code, 0) << command[0] << ": " << r.err;
+      if (json) {
+        EXPECT_TRUE(nlohmann::json::accept(r.out)) << r.out;
+      }
+    }
+  }
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+  FakeSource source = healthy_system();
+  for (auto args : {std::vector<const char*>{}, std::vector<const char*>{"frobnicate"},
+                    std::vector<const char*>{"topic"}, std::vector<const char*>{"topic", "info"},
+                    std::vector<const char*>{"topic", "info", "no-slash"},
+                    std::vector<const char*>{"topic", "hz", "/chatter", "--window", "-1"},
+                    std::vector<const char*>{"version", "--bogus"}}) {
+    const Outcome r = run(source, args);
+    EXPECT_EQ(r.code, 2) << (args.empty() ? "" : args[0]);
+    EXPECT_EQ(r.out, "");
+    EXPECT_NE(r.err.find("agnocast-cli: "), std::string::npos);
+  }
+}
+
+TEST(Cli, UsageErrorWithJsonPrintsAnErrorObject) {
+  FakeSource source = healthy_system();
+  const Outcome r = run(source, {"--json", "topic", "info"});
+  EXPECT_EQ(r.code, 2);
+  const auto value = nlohmann::json::parse(r.out);
+  EXPECT_EQ(value["exit_code"], 2);
+  EXPECT_TRUE(value["error"].is_string());
+}
+
+TEST(Cli, HelpExitsZero) {
+  FakeSource source = healthy_system();
+  const Outcome r = run(source, {"topic", "info", "--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("TOPIC"), std::string::npos);
+}
+
+TEST(Cli, ModuleNotLoadedExitsOneNamingTheFix) {
+  FakeSource source = healthy_system();
+  source.loaded = false;
+  const Outcome r = run(source, {"topic", "list"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("systemctl start agnocastd"), std::string::npos);
+}
+
+TEST(Cli, RuntimeErrorWithJsonPrintsOnlyAnErrorObject) {
+  FakeSource source = healthy_system();
+  const Outcome r = run(source, {"--json", "topic", "info", "/nope"});
+  EXPECT_EQ(r.code, 1);
+  const auto value = nlohmann::json::parse(r.out);
+  EXPECT_EQ(value["exit_code"], 1);
+  EXPECT_NE(value["error"].get<std::string>().find("/nope"), std::string::npos);
+}
+
+TEST(Cli, DoctorExitsOneWhenACheckFailsButStillPrintsTheChecks) {
+  FakeSource source = healthy_system();
+  source.loaded = false;
+  source.paths.clear();
+  const Outcome r = run(source, {"doctor", "--json"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(nlohmann::json::parse(r.out)["checks"].size(), 6u);
+  const Outcome table = run(source, {"doctor"});
+  EXPECT_EQ(table.code, 1);
+  EXPECT_NE(table.out.find("FAIL"), std::string::npos);
+}
+
+TEST(Cli, DaemonNotRunningExitsZeroWithAHint) {
+  FakeSource source = healthy_system();
+  source.alive.erase(50);
+  const Outcome r = run(source, {"daemon", "status"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("running            no"), std::string::npos);
+  EXPECT_NE(r.err.find("systemctl start agnocastd"), std::string::npos);
+}
+
+TEST(Cli, DaemonStatusFileOption) {
+  FakeSource source = healthy_system();
+  source.files["/tmp/d.json"] = source.files["/run/agnocast/agnocastd.json"];
+  source.files.erase("/run/agnocast/agnocastd.json");
+  const Outcome r = run(source, {"daemon", "status", "--status-file", "/tmp/d.json", "--json"});
+  EXPECT_TRUE(nlohmann::json::parse(r.out)["running"].get<bool>());
+}
+
+}  // namespace
+}  // namespace agnocast::cli

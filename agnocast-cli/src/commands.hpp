@@ -1,0 +1,50 @@
+// Every subcommand: a set_<cmd>_command() that wires it into CLI11 and pure
+// <cmd>_json() functions that build its value from an InspectionSource, plus
+// the table renderers of those values. Shapes follow SPEC §6.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+
+#include "cli.hpp"
+#include "inspection_source.hpp"
+
+namespace agnocast::cli {
+
+// Where agnocastd writes its status (it owns the file; the CLI only reads it).
+inline constexpr std::string_view default_daemon_status_path = "/run/agnocast/agnocastd.json";
+
+void set_topic_command(CLI::App& app, Context& context);
+nlohmann::json topic_list_json(InspectionSource& source);
+// Throws CliError when no endpoint of the topic exists.
+nlohmann::json topic_info_json(InspectionSource& source, const std::string& topic);
+// Publish rate and bandwidth from the kernel's counters over `window_s`
+// seconds, without subscribing. Throws CliError when the topic has no endpoint.
+nlohmann::json topic_hz_json(InspectionSource& source, const std::string& topic, double window_s);
+std::string topic_list_table(const nlohmann::json& value);
+std::string topic_info_table(const nlohmann::json& value);
+std::string topic_hz_table(const nlohmann::json& value);
+
+void set_queue_command(CLI::App& app, Context& context);
+nlohmann::json queue_list_json(InspectionSource& source);
+std::string queue_list_table(const nlohmann::json& value);
+
+void set_node_command(CLI::App& app, Context& context);
+nlohmann::json node_list_json(InspectionSource& source);
+std::string node_list_table(const nlohmann::json& value);
+
+void set_daemon_command(CLI::App& app, Context& context);
+nlohmann::json daemon_status_json(InspectionSource& source, const std::string& status_path);
+std::string daemon_status_table(const nlohmann::json& value);
+
+void set_doctor_command(CLI::App& app, Context& context);
+nlohmann::json doctor_json(InspectionSource& source, const std::string& daemon_status_path);
+std::string doctor_table(const nlohmann::json& value);
+
+void set_version_command(CLI::App& app, Context& context);
+nlohmann::json version_json(InspectionSource& source);
+std::string version_table(const nlohmann::json& value);
+
+}  // namespace agnocast::cli

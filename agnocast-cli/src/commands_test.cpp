@@ -1,0 +1,297 @@
+// The commands' JSON values and tables, built from fake system state.
+#include "commands.hpp"
+
+#include <gtest/gtest.h>
+
+#include "agnocast/errors.hpp"
+#include "fake_source.hpp"
+
+namespace agnocast::cli {
+namespace {
+
+using nlohmann::json;
+
+std::vector<std::string> keys_of(const json& object) {
+  std::vector<std::string> keys;
+  for (const auto& item : object.items()) keys.push_back(item.key());
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+TEST(TopicList, CountsEndpointsPerTopicSortedByName) {
+  FakeSource source = healthy_system();
+  TopicInfo early;
+  early.name = "/a";
+  source.topics.push_back(early);
+  const json value = topic_list_json(source);
+  EXPECT_EQ(value, json::parse(R"({"topics":[{"name":"/a","publishers":0,"subscribers":0},
+                                   {"name":"/chatter","publishers":1,"subscribers":2}]})"));
+  EXPECT_EQ(topic_list_table(value),
+            "NAME      PUBLISHERS  SUBSCRIBERS\n"
+            "/a                 0            0\n"
+            "/chatter           1            2\n");
+}
+
+TEST(TopicList, ModuleAbsentThrowsModuleNotLoaded) {
+  FakeSource source;
+  source.loaded = false;
+  EXPECT_THROW(topic_list_json(source), ModuleNotLoaded);
+}
+
+TEST(TopicInfo, HasSpecFieldsQueueDepthFromMqueueAndNullQueueForPolling) {
+  FakeSource source = healthy_system();
+  const json value = topic_info_json(source, "/chatter");
+  EXPECT_EQ(keys_of(value), (std::vector<std::string>{"name", "publishers", "subscribers"}));
+  EXPECT_EQ(value["publishers"][0], json::parse(R"({"id":0,"pid":100,"node":"talker","depth":10,
+                                                    "transient_local":false,"published":42})"));
+  EXPECT_EQ(value["subscribers"][0],
+            json::parse(R"({"id":1,"pid":200,"node":"listener","depth":10,"queue":"/chatter@1",
+                            "pending":3,"unreceived":3,"dropped":1})"));
+  EXPECT_TRUE(value["subscribers"][1]["queue"].is_null());
+  EXPECT_TRUE(value["subscribers"][1]["pending"].is_null());
+}
+
+TEST(TopicInfo, TableShowsBothSections) {
+  FakeSource source = healthy_system();
+  EXPECT_EQ(topic_info_table(topic_info_json(source, "/chatter")),
+            "topic /chatter\n"
+            "\n"
+            "publishers\n"
+            "ID  PID  NODE    DEPTH  TRANSIENT_LOCAL  PUBLISHED\n"
+            " 0  100  talker     10  no                      42\n"
+            "\n"
+            "subscribers\n"
+            "ID  PID  NODE      DEPTH  QUEUE       PENDING  UNRECEIVED  DROPPED\n"
+            " 1  200  listener     10  /chatter@1        3           3        1\n"
+            " 2  300  poller        1  -                 -           0        0\n");
+}
+
+TEST(TopicInfo, UnknownTopicIsARuntimeErrorNamingTopicList) {
+  FakeSource source = healthy_system();
+  try {
+    topic_info_json(source, "/nope");
+    FAIL() << "expected CliError";
+  } catch (const CliError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nope"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("topic list"), std::string::npos);
+  }
+}
+
+TEST(TopicHz, RateAndBandwidthFromCounterDeltasOverTheWindow) {
+  FakeSource source = healthy_system();
+  source.on_sleep = [](FakeSource& s) {
+    s.topics[0].publishers[0].published += 20;
+    s.topics[0].publishers[0].published_bytes += 20 * 1000;
+    PublisherInfo late;  // joined during the window: counts from zero
+    late.id = 3;
+    late.published = 5;
+    late.published_bytes = 500;
+    s.topics[0].publishers.push_back(late);
+  };
+  const json value = topic_hz_json(source, "/chatter", 2.0);
+  EXPECT_EQ(value, json::parse(R"({"name":"/chatter","window_s":2.0,"publishers":2,
+                                   "messages":25,"bytes":20500,"rate_hz":12.5,
+                                   "bytes_per_s":10250.0})"));
+  EXPECT_NE(topic_hz_table(value).find("rate_hz      12.5\n"), std::string::npos);
+}
+
+TEST(TopicHz, ASubscriberIsNeverCreated) {
+  FakeSource source = healthy_system();
+  topic_hz_json(source, "/chatter", 1.0);
+  EXPECT_EQ(source.topics[0].subscribers.size(), 2u);
+}
+
+TEST(QueueList, LiveQueueHasOwnerAndDepthStaleQueueHasNulls) {
+  FakeSource source = healthy_system();
+  source.queues["/ghost@7"] = {0, 10};
+  source.queues["/not-agnocast"] = {0, 10};
+  const json value = queue_list_json(source);
+  EXPECT_EQ(value, json::parse(R"({"queues":[
+      {"name":"/chatter@1","topic":"/chatter","subscriber_id":1,"pid":200,"pending":3,
+       "capacity":10,"stale":false},
+      {"name":"/ghost@7","topic":null,"subscriber_id":7,"pid":null,"pending":0,
+       "capacity":10,"stale":true}]})"));
+  EXPECT_EQ(queue_list_table(value),
+            "NAME        TOPIC     SUBSCRIBER_ID  PID  PENDING  CAPACITY  STALE\n"
+            "/chatter@1  /chatter              1  200        3        10  no\n"
+            "/ghost@7    -                     7    -        0        10  yes\n");
+}
+
+TEST(QueueList, QueueOfAnotherTopicsSubscriberIdIsStale) {
+  FakeSource source = healthy_system();
+  source.queues["/chatter@2"] = {0, 1};  // id 2 is the polling subscriber: it owns no queue
+  const json value = queue_list_json(source);
+  ASSERT_EQ(value["queues"].size(), 2u);
+  EXPECT_TRUE(value["queues"][1]["stale"].get<bool>());
+}
+
+TEST(QueueList, WithoutTheModuleEveryQueueIsStale) {
+  FakeSource source = healthy_system();
+  source.loaded = false;
+  const json value = queue_list_json(source);
+  ASSERT_EQ(value["queues"].size(), 1u);
+  EXPECT_TRUE(value["queues"][0]["stale"].get<bool>());
+}
+
+TEST(QueueList, UnreadableQueueHasNullDepth) {
+  FakeSource source = healthy_system();
+  source.unreadable_queues.insert("/chatter@1");
+  const json value = queue_list_json(source);
+  ASSERT_EQ(value["queues"].size(), 1u);
+  EXPECT_TRUE(value["queues"][0]["pending"].is_null());
+  EXPECT_TRUE(value["queues"][0]["capacity"].is_null());
+  EXPECT_FALSE(value["queues"][0]["stale"].get<bool>());
+  EXPECT_TRUE(topic_info_json(source, "/chatter")["subscribers"][0]["pending"].is_null());
+}
+
+TEST(NodeList, GroupsEndpointsByProcessAndLabel) {
+  FakeSource source = healthy_system();
+  TopicInfo status;
+  status.name = "/status";
+  PublisherInfo also_talker;
+  also_talker.pid = 100;
+  also_talker.node = "talker";
+  status.publishers.push_back(also_talker);
+  SubscriberInfo other_label;  // same process, another node label
+  other_label.pid = 100;
+  other_label.node = "monitor";
+  status.subscribers.push_back(other_label);
+  source.topics.push_back(status);
+  const json value = node_list_json(source);
+  EXPECT_EQ(value, json::parse(R"({"nodes":[
+      {"name":"monitor","pid":100,"publishes":[],"subscribes":["/status"]},
+      {"name":"talker","pid":100,"publishes":["/chatter","/status"],"subscribes":[]},
+      {"name":"listener","pid":200,"publishes":[],"subscribes":["/chatter"]},
+      {"name":"poller","pid":300,"publishes":[],"subscribes":["/chatter"]}]})"));
+  EXPECT_EQ(node_list_table(value),
+            "NAME      PID  PUBLISHES         SUBSCRIBES\n"
+            "monitor   100  -                 /status\n"
+            "talker    100  /chatter,/status  -\n"
+            "listener  200  -                 /chatter\n"
+            "poller    300  -                 /chatter\n");
+}
+
+TEST(DaemonStatus, RunningDaemonReportsItsStatusFile) {
+  FakeSource source = healthy_system();
+  const json value = daemon_status_json(source, "/run/agnocast/agnocastd.json");
+  EXPECT_EQ(value, json::parse(R"({"running":true,"pid":50,"module_loaded":true,
+      "module_version":"0.1.0","uptime_s":12,"processes_cleaned":2,"queues_removed":3,
+      "shm_removed":0})"));
+  EXPECT_EQ(daemon_status_table(value).rfind("running            yes\npid                50\n", 0),
+            0u);
+}
+
+TEST(DaemonStatus, DeadPidMeansNotRunningWithLiveModuleState) {
+  FakeSource source = healthy_system();
+  source.alive.erase(50);
+  const json value = daemon_status_json(source, "/run/agnocast/agnocastd.json");
+  EXPECT_FALSE(value["running"].get<bool>());
+  EXPECT_TRUE(value["pid"].is_null());
+  EXPECT_TRUE(value["module_loaded"].get<bool>());
+  EXPECT_EQ(value["module_version"], library_version.to_string());
+  EXPECT_TRUE(value["processes_cleaned"].is_null());
+  EXPECT_EQ(keys_of(value).size(), 8u);
+}
+
+TEST(DaemonStatus, ReusedPidOfAnotherProgramIsNotTheDaemon) {
+  FakeSource source = healthy_system();
+  source.files["/proc/50/comm"] = "bash\n";
+  EXPECT_FALSE(daemon_status_json(source, "/run/agnocast/agnocastd.json")["running"].get<bool>());
+}
+
+TEST(DaemonStatus, MissingOrGarbledFileMeansNotRunning) {
+  FakeSource source = healthy_system();
+  source.loaded = false;
+  EXPECT_FALSE(daemon_status_json(source, "/missing.json")["running"].get<bool>());
+  source.files["/bad.json"] = "{not json";
+  const json value = daemon_status_json(source, "/bad.json");
+  EXPECT_FALSE(value["running"].get<bool>());
+  EXPECT_FALSE(value["module_loaded"].get<bool>());
+  EXPECT_TRUE(value["module_version"].is_null());
+}
+
+const json& check_named(const json& doctor, const std::string& name) {
+  for (const json& c : doctor["checks"]) {
+    if (c["name"] == name) return c;
+  }
+  throw std::runtime_error("no check " + name);
+}
+
+TEST(Doctor, HealthySystemPassesEveryCheck) {
+  FakeSource source = healthy_system();
+  const json value = doctor_json(source, "/run/agnocast/agnocastd.json");
+  ASSERT_EQ(value["checks"].size(), 6u);
+  for (const json& c : value["checks"]) {
+    EXPECT_EQ(keys_of(c), (std::vector<std::string>{"detail", "name", "ok"}));
+    EXPECT_TRUE(c["ok"].get<bool>()) << c.dump();
+  }
+}
+
+TEST(Doctor, ModuleAbsentFailsModuleDeviceVersionWithTheFix) {
+  FakeSource source = healthy_system();
+  source.loaded = false;
+  source.paths.clear();
+  const json value = doctor_json(source, "/run/agnocast/agnocastd.json");
+  for (const char* name : {"module", "device", "version"}) {
+    EXPECT_FALSE(check_named(value, name)["ok"].get<bool>()) << name;
+  }
+  EXPECT_NE(
+      check_named(value, "module")["detail"].get<std::string>().find("systemctl start agnocastd"),
+      std::string::npos);
+  EXPECT_TRUE(check_named(value, "mqueue_mount")["ok"].get<bool>());
+}
+
+TEST(Doctor, IncompatibleModuleVersionFails) {
+  FakeSource source = healthy_system();
+  source.version.minor += 1;
+  EXPECT_FALSE(check_named(doctor_json(source, "/x"), "version")["ok"].get<bool>());
+}
+
+TEST(Doctor, PatchDifferenceIsCompatible) {
+  FakeSource source = healthy_system();
+  source.version.patch += 1;
+  EXPECT_TRUE(check_named(doctor_json(source, "/x"), "version")["ok"].get<bool>());
+}
+
+TEST(Doctor, InaccessibleDeviceFails) {
+  FakeSource source = healthy_system();
+  source.access_errors["/dev/agnocast"] = EACCES;
+  const json doctor = doctor_json(source, "/x");
+  const json& device = check_named(doctor, "device");
+  EXPECT_FALSE(device["ok"].get<bool>());
+  EXPECT_NE(device["detail"].get<std::string>().find("Permission denied"), std::string::npos);
+}
+
+TEST(Doctor, MqueueNotMountedFails) {
+  FakeSource source = healthy_system();
+  source.files["/proc/mounts"] = "proc /proc proc rw 0 0\n";
+  EXPECT_FALSE(check_named(doctor_json(source, "/x"), "mqueue_mount")["ok"].get<bool>());
+}
+
+TEST(Doctor, LoweredOrExhaustedMqueueLimitsFail) {
+  FakeSource source = healthy_system();
+  source.files["/proc/sys/fs/mqueue/msg_max"] = "4\n";
+  EXPECT_FALSE(check_named(doctor_json(source, "/x"), "mqueue_limits")["ok"].get<bool>());
+  source = healthy_system();
+  source.files["/proc/sys/fs/mqueue/queues_max"] = "256\n";
+  for (int i = 0; i < 256; ++i) source.queues["/q@" + std::to_string(i)] = {};
+  EXPECT_FALSE(check_named(doctor_json(source, "/x"), "mqueue_limits")["ok"].get<bool>());
+}
+
+TEST(Doctor, DaemonNotRunningFails) {
+  FakeSource source = healthy_system();
+  EXPECT_FALSE(check_named(doctor_json(source, "/missing.json"), "daemon")["ok"].get<bool>());
+}
+
+TEST(Version, ModuleIsNullWhenNotLoaded) {
+  FakeSource source;
+  source.loaded = false;
+  const json value = version_json(source);
+  EXPECT_EQ(value["library"], std::string(library_version_string));
+  EXPECT_EQ(value["cli"], std::string(library_version_string));
+  EXPECT_TRUE(value["module"].is_null());
+  EXPECT_EQ(keys_of(value), (std::vector<std::string>{"cli", "library", "module"}));
+}
+
+}  // namespace
+}  // namespace agnocast::cli

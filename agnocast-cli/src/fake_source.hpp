@@ -1,0 +1,123 @@
+// An InspectionSource made of plain data, for unit tests of the commands.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <set>
+
+#include "agnocast/errors.hpp"
+#include "inspection_source.hpp"
+
+namespace agnocast::cli {
+
+class FakeSource : public InspectionSource {
+ public:
+  bool loaded = true;
+  Version version = library_version;
+  std::vector<TopicInfo> topics;
+  std::map<std::string, QueueAttributes> queues;  // by queue name ("/chatter@1")
+  std::set<std::string> unreadable_queues;        // exist, but mq_open is refused
+  std::set<std::string> paths;                    // that exist
+  std::map<std::string, int> access_errors;       // path -> errno from access()
+  std::map<std::string, std::string> files;       // path -> content
+  std::set<pid_t> alive;
+  double clock = 100.0;
+  // Applied to `topics` on each sleep, to play counters advancing.
+  std::function<void(FakeSource&)> on_sleep;
+
+  std::optional<Version> module_version() override {
+    return loaded ? std::optional(version) : std::nullopt;
+  }
+  std::vector<TopicSummary> list_topics() override {
+    require_module();
+    std::vector<TopicSummary> list;
+    for (const TopicInfo& t : topics) {
+      list.push_back({t.name, static_cast<std::uint32_t>(t.publishers.size()),
+                      static_cast<std::uint32_t>(t.subscribers.size())});
+    }
+    return list;
+  }
+  std::optional<TopicInfo> topic_info(const std::string& topic) override {
+    require_module();
+    for (const TopicInfo& t : topics) {
+      if (t.name == topic) return t;
+    }
+    return std::nullopt;
+  }
+  std::vector<std::string> queue_files() override {
+    std::vector<std::string> names;
+    for (const auto& [name, attributes] : queues) names.push_back(name.substr(1));
+    return names;
+  }
+  std::optional<QueueAttributes> queue_attributes(const std::string& name) override {
+    const auto it = queues.find(name);
+    return it == queues.end() || unreadable_queues.count(name) > 0 ? std::nullopt
+                                                                   : std::optional(it->second);
+  }
+  bool path_exists(const std::string& path) override { return paths.count(path) > 0; }
+  int path_access(const std::string& path, int) override {
+    const auto it = access_errors.find(path);
+    return it == access_errors.end() ? 0 : it->second;
+  }
+  std::optional<std::string> read_file(const std::string& path) override {
+    const auto it = files.find(path);
+    return it == files.end() ? std::nullopt : std::optional(it->second);
+  }
+  bool process_alive(pid_t pid) override { return alive.count(pid) > 0; }
+  double now_seconds() override { return clock; }
+  void sleep_seconds(double seconds) override {
+    clock += seconds;
+    if (on_sleep) on_sleep(*this);
+  }
+
+ private:
+  void require_module() const {
+    if (!loaded) throw ModuleNotLoaded();
+  }
+};
+
+// A healthy system: /chatter with one talker (pid 100), a callback listener
+// (pid 200, queue /chatter@1 holding 3 wake-ups) and a polling one (pid 300).
+inline FakeSource healthy_system() {
+  FakeSource source;
+  TopicInfo chatter;
+  chatter.name = "/chatter";
+  PublisherInfo talker;
+  talker.id = 0;
+  talker.pid = 100;
+  talker.node = "talker";
+  talker.depth = 10;
+  talker.published = 42;
+  talker.published_bytes = 42 * 1024;
+  chatter.publishers.push_back(talker);
+  SubscriberInfo listener;
+  listener.id = 1;
+  listener.pid = 200;
+  listener.node = "listener";
+  listener.depth = 10;
+  listener.unreceived = 3;
+  listener.dropped = 1;
+  chatter.subscribers.push_back(listener);
+  SubscriberInfo poller;
+  poller.id = 2;
+  poller.pid = 300;
+  poller.node = "poller";
+  poller.depth = 1;
+  poller.polling = true;
+  chatter.subscribers.push_back(poller);
+  source.topics.push_back(chatter);
+  source.queues["/chatter@1"] = {3, 10};
+  source.paths = {"/sys/module/agnocast", "/dev/agnocast"};
+  source.files["/proc/mounts"] =
+      "proc /proc proc rw 0 0\nmqueue /dev/mqueue mqueue rw,relatime 0 0\n";
+  source.files["/proc/sys/fs/mqueue/msg_max"] = "10\n";
+  source.files["/proc/sys/fs/mqueue/queues_max"] = "256\n";
+  source.files["/run/agnocast/agnocastd.json"] =
+      R"({"running":true,"pid":50,"module_loaded":true,"module_version":"0.1.0",)"
+      R"("uptime_s":12,"processes_cleaned":2,"queues_removed":3,"shm_removed":0})";
+  source.files["/proc/50/comm"] = "agnocastd\n";
+  source.alive = {50, 100, 200, 300};
+  return source;
+}
+
+}  // namespace agnocast::cli

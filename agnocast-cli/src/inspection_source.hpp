@@ -1,0 +1,53 @@
+// Everything the CLI reads from the system, behind one interface so that the
+// commands are pure functions of it and unit tests can feed them fake state.
+#pragma once
+
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "agnocast/inspect.hpp"
+#include "agnocast/version.hpp"
+
+namespace agnocast::cli {
+
+// What mq_getattr says of a queue, read without consuming anything.
+struct QueueAttributes {
+  long pending = 0;   // mq_curmsgs
+  long capacity = 0;  // mq_maxmsg
+};
+
+class InspectionSource {
+ public:
+  virtual ~InspectionSource() = default;
+
+  // Kernel module state through libagnocast's inspection API.
+  // nullopt when the module is not loaded.
+  virtual std::optional<Version> module_version() = 0;
+  // These throw agnocast::ModuleNotLoaded when the module is absent.
+  virtual std::vector<TopicSummary> list_topics() = 0;
+  virtual std::optional<TopicInfo> topic_info(const std::string& topic) = 0;
+
+  // File names (without the leading '/') of every queue in the mqueue directory.
+  virtual std::vector<std::string> queue_files() = 0;
+  // nullopt when the queue does not exist or this user may not open it.
+  virtual std::optional<QueueAttributes> queue_attributes(const std::string& queue_name) = 0;
+
+  virtual bool path_exists(const std::string& path) = 0;
+  // 0 when access(path, mode) succeeds, else the errno.
+  virtual int path_access(const std::string& path, int mode) = 0;
+  // nullopt when the file cannot be read.
+  virtual std::optional<std::string> read_file(const std::string& path) = 0;
+  virtual bool process_alive(pid_t pid) = 0;
+
+  // Monotonic seconds and a sleep, for sampling counters over a window.
+  virtual double now_seconds() = 0;
+  virtual void sleep_seconds(double seconds) = 0;
+};
+
+// The real system: libagnocast, /dev/mqueue, /proc, the clock.
+InspectionSource& system_source();
+
+}  // namespace agnocast::cli

@@ -1,0 +1,80 @@
+#include <fcntl.h>
+#include <mqueue.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "agnocast/inspect.hpp"
+#include "agnocast/naming.hpp"
+#include "inspection_source.hpp"
+
+namespace agnocast::cli {
+namespace {
+
+class SystemSource final : public InspectionSource {
+ public:
+  std::optional<Version> module_version() override { return agnocast::module_version(); }
+  std::vector<TopicSummary> list_topics() override { return agnocast::list_topics(); }
+  std::optional<TopicInfo> topic_info(const std::string& topic) override {
+    return agnocast::topic_info(topic);
+  }
+
+  std::vector<std::string> queue_files() override {
+    std::vector<std::string> names;
+    std::error_code error;
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::string(mqueue_directory), error)) {
+      names.push_back(entry.path().filename().string());
+    }
+    return names;
+  }
+
+  std::optional<QueueAttributes> queue_attributes(const std::string& queue_name) override {
+    // O_RDONLY | O_NONBLOCK and no mq_receive: looking never consumes a wake-up.
+    const mqd_t queue = ::mq_open(queue_name.c_str(), O_RDONLY | O_NONBLOCK);
+    if (queue == static_cast<mqd_t>(-1)) return std::nullopt;
+    struct mq_attr attr {};
+    const int rc = ::mq_getattr(queue, &attr);
+    ::mq_close(queue);
+    if (rc != 0) return std::nullopt;
+    return QueueAttributes{attr.mq_curmsgs, attr.mq_maxmsg};
+  }
+
+  bool path_exists(const std::string& path) override { return ::access(path.c_str(), F_OK) == 0; }
+  int path_access(const std::string& path, int mode) override {
+    return ::access(path.c_str(), mode) == 0 ? 0 : errno;
+  }
+  std::optional<std::string> read_file(const std::string& path) override {
+    std::ifstream in(path);
+    if (!in) return std::nullopt;
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  bool process_alive(pid_t pid) override {
+    return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM);
+  }
+
+  double now_seconds() override {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  void sleep_seconds(double seconds) override {
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  }
+};
+
+}  // namespace
+
+InspectionSource& system_source() {
+  static SystemSource source;
+  return source;
+}
+
+}  // namespace agnocast::cli

@@ -1,0 +1,193 @@
+// agnocast-cli topic list | info TOPIC | hz TOPIC [--window SEC]
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "agnocast/naming.hpp"
+#include "commands.hpp"
+#include "table.hpp"
+
+namespace agnocast::cli {
+namespace {
+
+using nlohmann::json;
+using Align = Table::Align;
+
+double round3(double x) { return std::round(x * 1000.0) / 1000.0; }
+
+TopicInfo require_topic(InspectionSource& source, const std::string& topic) {
+  std::optional<TopicInfo> info = source.topic_info(topic);
+  if (!info) {
+    throw CliError("no publisher or subscriber uses topic '" + topic +
+                   "'; `agnocast-cli topic list` shows the topics that exist");
+  }
+  return *info;
+}
+
+json pending_of(InspectionSource& source, const std::optional<std::string>& queue) {
+  if (!queue) return nullptr;
+  const auto attributes = source.queue_attributes(*queue);
+  return attributes ? json(attributes->pending) : json(nullptr);
+}
+
+const CLI::Validator topic_name_validator(
+    [](std::string& topic) { return topic_name_problem(topic); }, "TOPIC", "topic name");
+
+}  // namespace
+
+json topic_list_json(InspectionSource& source) {
+  std::vector<TopicSummary> topics = source.list_topics();
+  std::sort(topics.begin(), topics.end(),
+            [](const auto& a, const auto& b) { return a.name < b.name; });
+  json list = json::array();
+  for (const TopicSummary& topic : topics) {
+    list.push_back({{"name", topic.name},
+                    {"publishers", topic.publishers},
+                    {"subscribers", topic.subscribers}});
+  }
+  return {{"topics", list}};
+}
+
+json topic_info_json(InspectionSource& source, const std::string& topic) {
+  TopicInfo info = require_topic(source, topic);
+  auto by_id = [](const auto& a, const auto& b) { return a.id < b.id; };
+  std::sort(info.publishers.begin(), info.publishers.end(), by_id);
+  std::sort(info.subscribers.begin(), info.subscribers.end(), by_id);
+
+  json publishers = json::array();
+  for (const PublisherInfo& p : info.publishers) {
+    publishers.push_back({{"id", p.id},
+                          {"pid", p.pid},
+                          {"node", p.node},
+                          {"depth", p.depth},
+                          {"transient_local", p.transient_local},
+                          {"published", p.published}});
+  }
+  json subscribers = json::array();
+  for (const SubscriberInfo& s : info.subscribers) {
+    // Polling subscribers are never woken, so they own no queue.
+    const std::optional<std::string> queue =
+        s.polling ? std::nullopt : std::optional(queue_name(info.name, s.id));
+    subscribers.push_back({{"id", s.id},
+                           {"pid", s.pid},
+                           {"node", s.node},
+                           {"depth", s.depth},
+                           {"queue", queue ? json(*queue) : json(nullptr)},
+                           {"pending", pending_of(source, queue)},
+                           {"unreceived", s.unreceived},
+                           {"dropped", s.dropped}});
+  }
+  return {{"name", info.name}, {"publishers", publishers}, {"subscribers", subscribers}};
+}
+
+json topic_hz_json(InspectionSource& source, const std::string& topic, double window_s) {
+  struct Counters {
+    std::uint64_t messages = 0;
+    std::uint64_t bytes = 0;
+  };
+  auto sample = [&] {
+    std::map<std::uint32_t, Counters> by_publisher;
+    for (const PublisherInfo& p : require_topic(source, topic).publishers) {
+      by_publisher[p.id] = {p.published, p.published_bytes};
+    }
+    return by_publisher;
+  };
+  const auto before = sample();
+  const double start = source.now_seconds();
+  source.sleep_seconds(window_s);
+  const auto after = sample();
+  const double elapsed = source.now_seconds() - start;
+
+  // A publisher that joined during the window counts from zero; one that left
+  // takes its last counts with it (the rate then under-reports).
+  Counters delta;
+  for (const auto& [id, now] : after) {
+    const auto then = before.find(id);
+    const Counters base = then == before.end() ? Counters{} : then->second;
+    delta.messages += now.messages - std::min(now.messages, base.messages);
+    delta.bytes += now.bytes - std::min(now.bytes, base.bytes);
+  }
+  const double seconds = elapsed > 0 ? elapsed : window_s;
+  return {{"name", topic},
+          {"window_s", round3(seconds)},
+          {"publishers", after.size()},
+          {"messages", delta.messages},
+          {"bytes", delta.bytes},
+          {"rate_hz", round3(static_cast<double>(delta.messages) / seconds)},
+          {"bytes_per_s", round3(static_cast<double>(delta.bytes) / seconds)}};
+}
+
+std::string topic_list_table(const json& value) {
+  Table table({{"NAME"}, {"PUBLISHERS", Align::right}, {"SUBSCRIBERS", Align::right}});
+  for (const json& t : value.at("topics")) {
+    table.add_row({cell(t.at("name")), cell(t.at("publishers")), cell(t.at("subscribers"))});
+  }
+  return table.render();
+}
+
+std::string topic_info_table(const json& value) {
+  Table publishers({{"ID", Align::right},
+                    {"PID", Align::right},
+                    {"NODE"},
+                    {"DEPTH", Align::right},
+                    {"TRANSIENT_LOCAL"},
+                    {"PUBLISHED", Align::right}});
+  for (const json& p : value.at("publishers")) {
+    publishers.add_row({cell(p.at("id")), cell(p.at("pid")), cell(p.at("node")),
+                        cell(p.at("depth")), cell(p.at("transient_local")),
+                        cell(p.at("published"))});
+  }
+  Table subscribers({{"ID", Align::right},
+                     {"PID", Align::right},
+                     {"NODE"},
+                     {"DEPTH", Align::right},
+                     {"QUEUE"},
+                     {"PENDING", Align::right},
+                     {"UNRECEIVED", Align::right},
+                     {"DROPPED", Align::right}});
+  for (const json& s : value.at("subscribers")) {
+    subscribers.add_row({cell(s.at("id")), cell(s.at("pid")), cell(s.at("node")),
+                         cell(s.at("depth")), cell(s.at("queue")), cell(s.at("pending")),
+                         cell(s.at("unreceived")), cell(s.at("dropped"))});
+  }
+  return "topic " + cell(value.at("name")) + "\n\npublishers\n" + publishers.render() +
+         "\nsubscribers\n" + subscribers.render();
+}
+
+std::string topic_hz_table(const json& value) {
+  return key_value_lines(
+      value, {"name", "window_s", "publishers", "messages", "bytes", "rate_hz", "bytes_per_s"});
+}
+
+void set_topic_command(CLI::App& app, Context& context) {
+  CLI::App* topic = app.add_subcommand("topic", "Topics, their endpoints and publish rates");
+  topic->require_subcommand(1);
+
+  CLI::App* list = topic->add_subcommand("list", "Every topic with its endpoint counts");
+  bind_command(*list, context,
+               {[&context] { return topic_list_json(context.source); }, topic_list_table});
+
+  auto name = std::make_shared<std::string>();
+  CLI::App* info = topic->add_subcommand("info", "Publishers and subscribers of one topic");
+  info->add_option("TOPIC", *name, "Topic name, e.g. /chatter")
+      ->required()
+      ->check(topic_name_validator);
+  bind_command(
+      *info, context,
+      {[&context, name] { return topic_info_json(context.source, *name); }, topic_info_table});
+
+  auto window = std::make_shared<double>(1.0);
+  CLI::App* hz = topic->add_subcommand(
+      "hz", "Publish rate and bandwidth of a topic, from kernel counters, without subscribing");
+  hz->add_option("TOPIC", *name, "Topic name, e.g. /chatter")
+      ->required()
+      ->check(topic_name_validator);
+  hz->add_option("--window", *window, "Seconds to sample over")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  bind_command(*hz, context,
+               {[&context, name, window] { return topic_hz_json(context.source, *name, *window); },
+                topic_hz_table});
+}
+
+}  // namespace agnocast::cli

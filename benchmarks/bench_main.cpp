@@ -17,7 +17,7 @@
 #include "iceoryx_runner.hpp"
 
 namespace bench = agnocast::bench;
-using nlohmann::json;
+using json = nlohmann::ordered_json;
 
 namespace {
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bench_support.hpp"
+#include "iceoryx_hoofs/log/logmanager.hpp"
 #include "iceoryx_posh/popo/untyped_publisher.hpp"
 #include "iceoryx_posh/popo/untyped_subscriber.hpp"
 #include "iceoryx_posh/popo/wait_set.hpp"
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
   app.add_option("--ack-fd", ack_fd)->required();
   app.add_option("--results-fd", results_fd);
   CLI11_PARSE(app, argc, argv);
+  iox::log::LogManager::GetLogManager().SetDefaultLogLevel(iox::log::LogLevel::kWarn);
   std::size_t size = bench::parse_size(size_text);
   if (role == "pub") return run_publisher(size, count, ready_fd, ack_fd);
   return run_subscriber(size, count, ready_fd, ack_fd, results_fd);

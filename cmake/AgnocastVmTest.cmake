@@ -9,7 +9,7 @@
 # path (copied too); either is run by its file name from /opt/agnocast/bin,
 # which is on PATH.  TARGETS and FILES are further programs or data the test
 # needs, copied to the same place with every shared library they link.
-# The VM runs each test as root in a fresh /tmp/<NAME> working directory with
+# The VM runs each test as root in a fresh /tmp/vm-tests/<NAME> directory with
 # agnocast.ko loaded (its path is $AGNOCAST_MODULE), one after another;
 # TIMEOUT (default 120 s) bounds one test.
 function(agnocast_add_vm_test)

@@ -129,7 +129,7 @@ TEST(Cli, DoctorExitsOneWhenACheckFailsButStillPrintsTheChecks) {
 
 TEST(Cli, DaemonNotRunningExitsZeroWithAHint) {
   FakeSource source = healthy_system();
-  source.alive.erase(50);
+  source.locks["/run/agnocast/agnocastd.lock"] = false;
   const Outcome r = run(source, {"daemon", "status"});
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find("running            no"), std::string::npos);
@@ -139,6 +139,7 @@ TEST(Cli, DaemonNotRunningExitsZeroWithAHint) {
 TEST(Cli, DaemonStatusFileOption) {
   FakeSource source = healthy_system();
   source.files["/tmp/d.json"] = source.files["/run/agnocast/agnocastd.json"];
+  source.locks["/tmp/agnocastd.lock"] = true;
   source.files.erase("/run/agnocast/agnocastd.json");
   const Outcome r = run(source, {"daemon", "status", "--status-file", "/tmp/d.json", "--json"});
   EXPECT_TRUE(nlohmann::json::parse(r.out)["running"].get<bool>());

@@ -13,9 +13,6 @@
 
 namespace agnocast::cli {
 
-// Where agnocastd writes its status (it owns the file; the CLI only reads it).
-inline constexpr std::string_view default_daemon_status_path = "/run/agnocast/agnocastd.json";
-
 void set_topic_command(CLI::App& app, Context& context);
 nlohmann::json topic_list_json(InspectionSource& source);
 // Throws CliError when no endpoint of the topic exists.
@@ -36,6 +33,7 @@ nlohmann::json node_list_json(InspectionSource& source);
 std::string node_list_table(const nlohmann::json& value);
 
 void set_daemon_command(CLI::App& app, Context& context);
+// `status_path` is agnocastd's status file; its lock file sits beside it.
 nlohmann::json daemon_status_json(InspectionSource& source, const std::string& status_path);
 std::string daemon_status_table(const nlohmann::json& value);
 

@@ -175,15 +175,15 @@ TEST(DaemonStatus, RunningDaemonReportsItsStatusFile) {
   FakeSource source = healthy_system();
   const json value = daemon_status_json(source, "/run/agnocast/agnocastd.json");
   EXPECT_EQ(value, json::parse(R"({"running":true,"pid":50,"module_loaded":true,
-      "module_version":"0.1.0","uptime_s":12,"processes_cleaned":2,"queues_removed":3,
+      "module_version":"0.1.0","uptime_s":100,"processes_cleaned":2,"queues_removed":3,
       "shm_removed":0})"));
   EXPECT_EQ(daemon_status_table(value).rfind("running            yes\npid                50\n", 0),
             0u);
 }
 
-TEST(DaemonStatus, DeadPidMeansNotRunningWithLiveModuleState) {
+TEST(DaemonStatus, ReleasedLockMeansACrashedDaemonNotRunningWithLiveModuleState) {
   FakeSource source = healthy_system();
-  source.alive.erase(50);
+  source.locks["/run/agnocast/agnocastd.lock"] = false;
   const json value = daemon_status_json(source, "/run/agnocast/agnocastd.json");
   EXPECT_FALSE(value["running"].get<bool>());
   EXPECT_TRUE(value["pid"].is_null());
@@ -193,10 +193,28 @@ TEST(DaemonStatus, DeadPidMeansNotRunningWithLiveModuleState) {
   EXPECT_EQ(keys_of(value).size(), 8u);
 }
 
-TEST(DaemonStatus, ReusedPidOfAnotherProgramIsNotTheDaemon) {
+TEST(DaemonStatus, CleanStopWritesRunningFalse) {
   FakeSource source = healthy_system();
-  source.files["/proc/50/comm"] = "bash\n";
+  source.files["/run/agnocast/agnocastd.json"] = R"({"running":false,"pid":50})";
   EXPECT_FALSE(daemon_status_json(source, "/run/agnocast/agnocastd.json")["running"].get<bool>());
+}
+
+TEST(DaemonStatus, WithoutLockFileFallsBackToThePid) {
+  FakeSource source = healthy_system();
+  source.locks.clear();
+  EXPECT_TRUE(daemon_status_json(source, "/run/agnocast/agnocastd.json")["running"].get<bool>());
+  source.files["/proc/50/comm"] = "bash\n";  // the pid was reused by another program
+  EXPECT_FALSE(daemon_status_json(source, "/run/agnocast/agnocastd.json")["running"].get<bool>());
+  source.files.erase("/proc/50/comm");
+  source.alive.erase(50);
+  EXPECT_FALSE(daemon_status_json(source, "/run/agnocast/agnocastd.json")["running"].get<bool>());
+}
+
+TEST(DaemonStatus, LockFileIsLookedForBesideAnOverriddenStatusFile) {
+  FakeSource source = healthy_system();
+  source.files["/tmp/x/agnocastd.json"] = source.files["/run/agnocast/agnocastd.json"];
+  source.locks["/tmp/x/agnocastd.lock"] = false;
+  EXPECT_FALSE(daemon_status_json(source, "/tmp/x/agnocastd.json")["running"].get<bool>());
 }
 
 TEST(DaemonStatus, MissingOrGarbledFileMeansNotRunning) {

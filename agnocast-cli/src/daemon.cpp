@@ -1,6 +1,11 @@
-// agnocast-cli daemon status: agnocastd's own status file, checked against a
-// live process, so a daemon that died without cleaning up shows as stopped.
+// agnocast-cli daemon status: agnocastd's own status file (its path comes from
+// agnocastd's header), checked against its lock so a crashed daemon shows as stopped.
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+
 #include "agnocast/version.hpp"
+#include "agnocastd/status_file.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -12,15 +17,6 @@ using nlohmann::json;
 const std::vector<std::string> counter_keys = {"uptime_s", "processes_cleaned", "queues_removed",
                                                "shm_removed"};
 
-// The status file names a pid; it is the daemon only if that process is alive
-// and, where /proc tells, is called agnocastd (pids are reused).
-bool daemon_alive(InspectionSource& source, pid_t pid) {
-  if (!source.process_alive(pid)) return false;
-  const std::optional<std::string> comm =
-      source.read_file("/proc/" + std::to_string(pid) + "/comm");
-  return !comm || comm->rfind("agnocastd", 0) == 0;
-}
-
 std::optional<json> read_status(InspectionSource& source, const std::string& path) {
   const std::optional<std::string> text = source.read_file(path);
   if (!text) return std::nullopt;
@@ -31,16 +27,42 @@ std::optional<json> read_status(InspectionSource& source, const std::string& pat
   return status;
 }
 
+// A daemon that crashed leaves "running":true behind. While it runs it holds
+// its lock file (beside the status file) exclusively; where that file cannot
+// be opened, its pid must be alive and, where /proc tells, be agnocastd.
+bool daemon_alive(InspectionSource& source, const json& status, const std::string& status_path) {
+  if (!status.value("running", false)) return false;
+  const std::string lock = (std::filesystem::path(status_path).parent_path() /
+                            std::filesystem::path(std::string(agnocastd::lock_path)).filename())
+                               .string();
+  if (const std::optional<bool> locked = source.exclusively_locked(lock)) return *locked;
+  const pid_t pid = status.at("pid").get<pid_t>();
+  if (!source.process_alive(pid)) return false;
+  const std::optional<std::string> comm =
+      source.read_file("/proc/" + std::to_string(pid) + "/comm");
+  return !comm || comm->rfind("agnocastd", 0) == 0;
+}
+
+// uptime_s in the file is as of its last write; started_at gives it exactly.
+json uptime_of(InspectionSource& source, const json& status) {
+  if (status.contains("started_at") && status["started_at"].is_number()) {
+    const double uptime = source.unix_time() - status["started_at"].get<double>();
+    return static_cast<std::int64_t>(std::max(0.0, uptime));
+  }
+  return status.value("uptime_s", json(nullptr));
+}
+
 }  // namespace
 
 json daemon_status_json(InspectionSource& source, const std::string& status_path) {
   const std::optional<json> status = read_status(source, status_path);
-  if (status && daemon_alive(source, status->at("pid").get<pid_t>())) {
+  if (status && daemon_alive(source, *status, status_path)) {
     json value = {{"running", true},
                   {"pid", status->at("pid")},
                   {"module_loaded", status->value("module_loaded", json(nullptr))},
                   {"module_version", status->value("module_version", json(nullptr))}};
     for (const std::string& key : counter_keys) value[key] = status->value(key, json(nullptr));
+    value["uptime_s"] = uptime_of(source, *status);
     return value;
   }
   // No daemon: what it would report about the module, the CLI sees for itself.
@@ -61,7 +83,7 @@ std::string daemon_status_table(const json& value) {
 void set_daemon_command(CLI::App& app, Context& context) {
   CLI::App* daemon = app.add_subcommand("daemon", "The supervisor daemon agnocastd");
   daemon->require_subcommand(1);
-  auto status_path = std::make_shared<std::string>(default_daemon_status_path);
+  auto status_path = std::make_shared<std::string>(agnocastd::status_path);
   CLI::App* status = daemon->add_subcommand(
       "status", "Whether agnocastd runs, and what it has cleaned up (exit 0 either way)");
   status->add_option("--status-file", *status_path, "agnocastd's status file")

@@ -7,6 +7,7 @@
 
 #include "agnocast/naming.hpp"
 #include "agnocast/version.hpp"
+#include "agnocastd/status_file.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -151,7 +152,7 @@ std::string doctor_table(const json& value) {
 }
 
 void set_doctor_command(CLI::App& app, Context& context) {
-  auto status_path = std::make_shared<std::string>(default_daemon_status_path);
+  auto status_path = std::make_shared<std::string>(agnocastd::status_path);
   CLI::App* doctor = app.add_subcommand(
       "doctor", "Check the module, device, versions, mqueue and daemon (exit 1 if any fails)");
   doctor->add_option("--status-file", *status_path, "agnocastd's status file")

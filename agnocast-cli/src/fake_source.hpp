@@ -21,7 +21,9 @@ class FakeSource : public InspectionSource {
   std::map<std::string, int> access_errors;       // path -> errno from access()
   std::map<std::string, std::string> files;       // path -> content
   std::set<pid_t> alive;
+  std::map<std::string, bool> locks;  // path -> held exclusively
   double clock = 100.0;
+  double unix_clock = 1'700'000'100.0;
   // Applied to `topics` on each sleep, to play counters advancing.
   std::function<void(FakeSource&)> on_sleep;
 
@@ -64,7 +66,12 @@ class FakeSource : public InspectionSource {
     return it == files.end() ? std::nullopt : std::optional(it->second);
   }
   bool process_alive(pid_t pid) override { return alive.count(pid) > 0; }
+  std::optional<bool> exclusively_locked(const std::string& path) override {
+    const auto it = locks.find(path);
+    return it == locks.end() ? std::nullopt : std::optional(it->second);
+  }
   double now_seconds() override { return clock; }
+  double unix_time() override { return unix_clock; }
   void sleep_seconds(double seconds) override {
     clock += seconds;
     if (on_sleep) on_sleep(*this);
@@ -114,7 +121,9 @@ inline FakeSource healthy_system() {
   source.files["/proc/sys/fs/mqueue/queues_max"] = "256\n";
   source.files["/run/agnocast/agnocastd.json"] =
       R"({"running":true,"pid":50,"module_loaded":true,"module_version":"0.1.0",)"
-      R"("uptime_s":12,"processes_cleaned":2,"queues_removed":3,"shm_removed":0})";
+      R"("uptime_s":12,"started_at":1700000000,"processes_cleaned":2,"queues_removed":3,)"
+      R"("shm_removed":0})";
+  source.locks["/run/agnocast/agnocastd.lock"] = true;
   source.files["/proc/50/comm"] = "agnocastd\n";
   source.alive = {50, 100, 200, 300};
   return source;

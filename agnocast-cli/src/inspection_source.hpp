@@ -41,9 +41,15 @@ class InspectionSource {
   // nullopt when the file cannot be read.
   virtual std::optional<std::string> read_file(const std::string& path) = 0;
   virtual bool process_alive(pid_t pid) = 0;
+  // Whether another process holds an exclusive flock on the file (tested with
+  // a non-blocking shared lock on a read-only descriptor); nullopt when the
+  // file cannot be opened.
+  virtual std::optional<bool> exclusively_locked(const std::string& path) = 0;
 
   // Monotonic seconds and a sleep, for sampling counters over a window.
   virtual double now_seconds() = 0;
+  // Seconds since the Unix epoch, for timestamps other programs wrote.
+  virtual double unix_time() = 0;
   virtual void sleep_seconds(double seconds) = 0;
 };
 

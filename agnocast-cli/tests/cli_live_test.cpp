@@ -1,0 +1,407 @@
+// agnocast-cli against a live system in the VM: a talker, a listener, a
+// stopped listener (its pending wake-ups and unreceived entries grow) and a
+// hand-made stale queue /ghost@7. Every command's table and JSON are checked,
+// the exit codes 0/1/2, and, last, doctor failing once the module is removed.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using nlohmann::json;
+
+struct Outcome {
+  int code = -1;
+  std::string out;
+  std::string err;
+  json value() const { return json::parse(out); }
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+Outcome cli(const std::string& args) {
+  const int status = std::system(("agnocast-cli " + args + " >cli.out 2>cli.err").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp("cli.out"), slurp("cli.err")};
+}
+
+pid_t spawn(const std::vector<std::string>& args, const std::string& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, STDOUT_FILENO);
+    ::dup2(fd, STDERR_FILENO);
+    std::vector<char*> argv;
+    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+    argv.push_back(nullptr);
+    ::execvp(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+void stop(pid_t& pid) {
+  if (pid <= 0) return;
+  ::kill(pid, SIGCONT);
+  ::kill(pid, SIGTERM);
+  ::waitpid(pid, nullptr, 0);
+  pid = -1;
+}
+
+// Polls `condition` every 100 ms for up to `seconds` (TCG is slow).
+bool eventually(const std::function<bool()>& condition, double seconds = 30) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return true;
+}
+
+// The element of `array` whose `key` equals `wanted`, or null.
+json find_by(const json& array, const std::string& key, const json& wanted) {
+  for (const json& item : array) {
+    if (item.at(key) == wanted) return item;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> words_of(const std::string& line) {
+  std::vector<std::string> words;
+  std::istringstream in(line);
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
+// The table row whose first word is `first` (after the header), split in words.
+std::vector<std::string> row_starting(const std::string& table, const std::string& first) {
+  for (const std::string& line : lines_of(table)) {
+    const auto words = words_of(line);
+    if (!words.empty() && words[0] == first) return words;
+  }
+  return {};
+}
+
+// The table row containing `needle`, as is.
+std::string line_containing(const std::string& table, const std::string& needle) {
+  for (const std::string& line : lines_of(table)) {
+    if (line.find(needle) != std::string::npos) return line;
+  }
+  return {};
+}
+
+// Right-aligned columns end where their header ends.
+void expect_ends_under_header(const std::string& table, const std::string& header,
+                              const std::string& row) {
+  const std::string head = lines_of(table).at(0);
+  const std::size_t end = head.find(header) + header.size();
+  ASSERT_NE(head.find(header), std::string::npos) << head;
+  ASSERT_FALSE(row.empty());
+  EXPECT_TRUE(row.size() >= end && row[end - 1] != ' ' && (row.size() == end || row[end] == ' '))
+      << "column " << header << " misaligned:\n"
+      << head << "\n"
+      << row;
+}
+
+const std::string topic = "/chatter";
+
+class CliLive : public ::testing::Test {
+ protected:
+  static inline pid_t listener = -1, stopped = -1, talker = -1;
+
+  static void SetUpTestSuite() {
+    listener = spawn({"agnocast-listener", "--topic", topic, "--node", "listener", "--depth", "10",
+                      "--timeout", "600"},
+                     "listener.log");
+    stopped = spawn({"agnocast-listener", "--topic", topic, "--node", "stopped", "--depth", "10",
+                     "--timeout", "600"},
+                    "stopped.log");
+    ASSERT_TRUE(eventually([] {
+      const Outcome r = cli("topic list --json");
+      const json t = r.code == 0 ? find_by(r.value()["topics"], "name", topic) : json();
+      return !t.is_null() && t["subscribers"] == 2;
+    })) << "the listeners never subscribed";
+    ASSERT_EQ(::kill(stopped, SIGSTOP), 0);
+    talker = spawn({"agnocast-talker", "--topic", topic, "--node", "talker", "--depth", "10",
+                    "--rate", "50", "--size", "1000"},
+                   "talker.log");
+    // A queue of the agnocast pattern that no subscriber owns.
+    const int ghost = ::open("/dev/mqueue/ghost@7", O_RDWR | O_CREAT, 0600);
+    ASSERT_GE(ghost, 0) << "cannot create /dev/mqueue/ghost@7";
+    ::close(ghost);
+    // Let the stopped listener's queue fill and its entries pile up.
+    ASSERT_TRUE(eventually([] {
+      const Outcome r = cli("topic info /chatter --json");
+      if (r.code != 0) return false;
+      const json s = find_by(r.value()["subscribers"], "pid", stopped);
+      return !s.is_null() && s["pending"] == 10 && s["unreceived"] == 10 && s["dropped"] > 0;
+    })) << slurp("cli.out");
+  }
+
+  static void TearDownTestSuite() {
+    stop(talker);
+    stop(stopped);
+    stop(listener);
+  }
+};
+
+TEST_F(CliLive, TopicList) {
+  const Outcome r = cli("topic list --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(find_by(r.value()["topics"], "name", topic),
+            json({{"name", topic}, {"publishers", 1}, {"subscribers", 2}}));
+
+  const Outcome table = cli("topic list");
+  ASSERT_EQ(table.code, 0);
+  EXPECT_EQ(words_of(lines_of(table.out).at(0)),
+            (std::vector<std::string>{"NAME", "PUBLISHERS", "SUBSCRIBERS"}));
+  EXPECT_EQ(row_starting(table.out, topic), (std::vector<std::string>{topic, "1", "2"}));
+  expect_ends_under_header(table.out, "SUBSCRIBERS", line_containing(table.out, topic));
+}
+
+TEST_F(CliLive, TopicInfo) {
+  const Outcome r = cli("--json topic info /chatter");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json info = r.value();
+  EXPECT_EQ(info["name"], topic);
+  ASSERT_EQ(info["publishers"].size(), 1u);
+  const json pub = info["publishers"][0];
+  EXPECT_EQ(pub["pid"], talker);
+  EXPECT_EQ(pub["node"], "talker");
+  EXPECT_EQ(pub["depth"], 10);
+  EXPECT_EQ(pub["transient_local"], false);
+  EXPECT_GT(pub["published"].get<int>(), 0);
+
+  const json live = find_by(info["subscribers"], "pid", listener);
+  const json frozen = find_by(info["subscribers"], "pid", stopped);
+  ASSERT_FALSE(live.is_null());
+  ASSERT_FALSE(frozen.is_null());
+  EXPECT_EQ(live["node"], "listener");
+  EXPECT_EQ(live["queue"], "/chatter@" + live["id"].dump());
+  EXPECT_EQ(frozen["node"], "stopped");
+  EXPECT_EQ(frozen["queue"], "/chatter@" + frozen["id"].dump());
+  EXPECT_EQ(frozen["pending"], 10);  // a full queue: the talker never blocks on it
+  EXPECT_EQ(frozen["unreceived"], 10);
+  EXPECT_GT(frozen["dropped"].get<int>(), 0);
+  for (const json& s : info["subscribers"]) {
+    EXPECT_EQ(s.size(), 8u) << s.dump();
+  }
+
+  const Outcome table = cli("topic info /chatter");
+  ASSERT_EQ(table.code, 0);
+  EXPECT_EQ(lines_of(table.out).at(0), "topic /chatter");
+  const auto talker_row = row_starting(table.out, pub["id"].dump());
+  ASSERT_EQ(talker_row.size(), 6u) << table.out;
+  EXPECT_EQ(talker_row[1], std::to_string(talker));
+  EXPECT_EQ(talker_row[2], "talker");
+  const auto frozen_row = row_starting(table.out, frozen["id"].dump());
+  ASSERT_EQ(frozen_row.size(), 8u) << table.out;
+  EXPECT_EQ(frozen_row[1], std::to_string(stopped));
+  EXPECT_EQ(frozen_row[4], frozen["queue"]);
+  EXPECT_EQ(frozen_row[5], "10");
+  EXPECT_EQ(frozen_row[6], "10");
+  EXPECT_NE(table.out.find("PENDING  UNRECEIVED  DROPPED"), std::string::npos);
+}
+
+TEST_F(CliLive, TopicHzMeasuresWithoutSubscribing) {
+  const Outcome r = cli("topic hz /chatter --window 2 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json hz = r.value();
+  EXPECT_EQ(hz["name"], topic);
+  EXPECT_GE(hz["window_s"].get<double>(), 2.0);
+  EXPECT_GT(hz["messages"].get<int>(), 0);
+  EXPECT_GT(hz["rate_hz"].get<double>(), 0.0);
+  // The library reports a fixed size per publish (the message object itself;
+  // nested containers are not counted), so bytes are a multiple of messages.
+  EXPECT_GT(hz["bytes_per_s"].get<double>(), 0.0);
+  EXPECT_EQ(hz["bytes"].get<std::uint64_t>() % hz["messages"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(cli("topic list --json").value()["topics"][0]["subscribers"], 2);
+
+  const Outcome table = cli("topic hz /chatter --window 1");
+  ASSERT_EQ(table.code, 0);
+  EXPECT_EQ(row_starting(table.out, "name"), (std::vector<std::string>{"name", topic}));
+  EXPECT_EQ(row_starting(table.out, "rate_hz").size(), 2u);
+}
+
+TEST_F(CliLive, QueueListShowsOwnersDepthsAndTheStaleGhost) {
+  const json info = cli("topic info /chatter --json").value();
+  const json frozen = find_by(info["subscribers"], "pid", stopped);
+  const Outcome r = cli("queue list --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json queues = r.value()["queues"];
+
+  const json frozen_queue = find_by(queues, "name", frozen["queue"]);
+  ASSERT_FALSE(frozen_queue.is_null()) << queues.dump();
+  EXPECT_EQ(frozen_queue, json({{"name", frozen["queue"]},
+                                {"topic", topic},
+                                {"subscriber_id", frozen["id"]},
+                                {"pid", stopped},
+                                {"pending", 10},
+                                {"capacity", 10},
+                                {"stale", false}}));
+  const json live_queue = find_by(queues, "pid", listener);
+  ASSERT_FALSE(live_queue.is_null());
+  EXPECT_EQ(live_queue["stale"], false);
+  EXPECT_EQ(live_queue["capacity"], 10);
+
+  EXPECT_EQ(find_by(queues, "name", "/ghost@7"), json({{"name", "/ghost@7"},
+                                                       {"topic", nullptr},
+                                                       {"subscriber_id", 7},
+                                                       {"pid", nullptr},
+                                                       {"pending", 0},
+                                                       {"capacity", 10},
+                                                       {"stale", true}}));
+
+  const Outcome table = cli("queue list");
+  ASSERT_EQ(table.code, 0);
+  EXPECT_EQ(row_starting(table.out, "/ghost@7"),
+            (std::vector<std::string>{"/ghost@7", "-", "7", "-", "0", "10", "yes"}));
+  EXPECT_EQ(row_starting(table.out, frozen["queue"]),
+            (std::vector<std::string>{frozen["queue"], topic, frozen["id"].dump(),
+                                      std::to_string(stopped), "10", "10", "no"}));
+  expect_ends_under_header(table.out, "CAPACITY", line_containing(table.out, "/ghost@7"));
+}
+
+TEST_F(CliLive, NodeListGroupsByProcess) {
+  const Outcome r = cli("node list --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json nodes = r.value()["nodes"];
+  EXPECT_EQ(find_by(nodes, "pid", talker), json({{"name", "talker"},
+                                                 {"pid", talker},
+                                                 {"publishes", {topic}},
+                                                 {"subscribes", json::array()}}));
+  EXPECT_EQ(find_by(nodes, "pid", stopped), json({{"name", "stopped"},
+                                                  {"pid", stopped},
+                                                  {"publishes", json::array()},
+                                                  {"subscribes", {topic}}}));
+
+  const Outcome table = cli("node list");
+  ASSERT_EQ(table.code, 0);
+  EXPECT_EQ(row_starting(table.out, "talker"),
+            (std::vector<std::string>{"talker", std::to_string(talker), topic, "-"}));
+  EXPECT_EQ(row_starting(table.out, "listener"),
+            (std::vector<std::string>{"listener", std::to_string(listener), "-", topic}));
+}
+
+TEST_F(CliLive, VersionReportsTheLoadedModule) {
+  const Outcome r = cli("version --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json v = r.value();
+  EXPECT_TRUE(v["module"].is_string());
+  EXPECT_EQ(v["module"], v["library"]);
+  EXPECT_EQ(row_starting(cli("version").out, "module"),
+            (std::vector<std::string>{"module", v["module"]}));
+}
+
+TEST_F(CliLive, DoctorWithoutDaemonFailsOnlyTheDaemonCheck) {
+  const Outcome r = cli("doctor --json");
+  EXPECT_EQ(r.code, 1);
+  for (const json& check : r.value()["checks"]) {
+    EXPECT_EQ(check["ok"], check["name"] != "daemon") << check.dump();
+  }
+  const Outcome table = cli("doctor");
+  EXPECT_EQ(table.code, 1);
+  EXPECT_EQ(row_starting(table.out, "daemon").at(1), "FAIL");
+  EXPECT_EQ(row_starting(table.out, "module").at(1), "ok");
+}
+
+TEST_F(CliLive, DaemonStatusStoppedThenRunning) {
+  Outcome r = cli("daemon status --json");
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(r.value()["running"], false);
+  EXPECT_EQ(r.value()["module_loaded"], true);
+  EXPECT_NE(r.err.find("systemctl start agnocastd"), std::string::npos);
+
+  // agnocastd sweeps stale queues: the ghost test above has already run.
+  pid_t daemon = spawn({"agnocastd", "--no-load"}, "agnocastd.log");
+  ASSERT_TRUE(eventually([&] {
+    r = cli("daemon status --json");
+    return r.code == 0 && r.value()["running"] == true;
+  })) << r.out
+      << slurp("agnocastd.log");
+  const json status = r.value();
+  EXPECT_EQ(status["pid"], daemon);
+  EXPECT_EQ(status["module_loaded"], true);
+  EXPECT_EQ(status["module_version"], cli("version --json").value()["module"]);
+  EXPECT_GE(status["uptime_s"].get<int>(), 0);
+  EXPECT_EQ(status.size(), 8u);
+  EXPECT_EQ(cli("doctor").code, 0) << cli("doctor").out;
+  EXPECT_EQ(row_starting(cli("daemon status").out, "running"),
+            (std::vector<std::string>{"running", "yes"}));
+  ::kill(daemon, SIGTERM);
+  ::waitpid(daemon, nullptr, 0);
+  EXPECT_EQ(cli("daemon status --json").value()["running"], false);
+}
+
+TEST_F(CliLive, ExitCodes) {
+  EXPECT_EQ(cli("topic list").code, 0);
+  const Outcome usage = cli("topic info");
+  EXPECT_EQ(usage.code, 2);
+  EXPECT_EQ(usage.out, "");
+  EXPECT_EQ(cli("frobnicate").code, 2);
+  EXPECT_EQ(cli("topic info bad-name").code, 2);
+  const Outcome json_usage = cli("--json queue");
+  EXPECT_EQ(json_usage.code, 2);
+  EXPECT_EQ(json_usage.value()["exit_code"], 2);
+  const Outcome missing = cli("topic info /nope");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("topic list"), std::string::npos);
+  const Outcome json_missing = cli("topic info /nope --json");
+  EXPECT_EQ(json_missing.code, 1);
+  EXPECT_EQ(json_missing.value()["exit_code"], 1);
+}
+
+// Last: it removes the module (and puts it back).
+TEST_F(CliLive, WithoutTheModuleDoctorFailsAndCommandsSayHowToFix) {
+  TearDownTestSuite();
+  ASSERT_EQ(std::system("rmmod agnocast"), 0) << "cannot remove agnocast.ko";
+
+  const Outcome doctor = cli("doctor --json");
+  EXPECT_EQ(doctor.code, 1);
+  for (const json& check : doctor.value()["checks"]) {
+    if (check["name"] == "module" || check["name"] == "device" || check["name"] == "version") {
+      EXPECT_EQ(check["ok"], false) << check.dump();
+    }
+  }
+  const Outcome list = cli("topic list");
+  EXPECT_EQ(list.code, 1);
+  EXPECT_EQ(list.out, "");
+  EXPECT_NE(list.err.find("systemctl start agnocastd"), std::string::npos) << list.err;
+  const Outcome version = cli("version --json");
+  EXPECT_EQ(version.code, 0);
+  EXPECT_TRUE(version.value()["module"].is_null());
+  // Every leftover queue is stale without the module.
+  for (const json& q : cli("queue list --json").value()["queues"]) {
+    EXPECT_EQ(q["stale"], true) << q.dump();
+  }
+
+  const char* module = std::getenv("AGNOCAST_MODULE");
+  ASSERT_NE(module, nullptr);
+  EXPECT_EQ(std::system(("insmod " + std::string(module)).c_str()), 0);
+  EXPECT_EQ(cli("topic list").code, 0);
+}
+
+}  // namespace

@@ -126,7 +126,9 @@ void expect_ends_under_header(const std::string& table, const std::string& heade
       << row;
 }
 
-const std::string topic = "/chatter";
+// A nested name, so queue names show the mangling ('/' -> '_').
+const std::string topic = "/cli_live/chatter";
+const std::string queue_prefix = "/cli_live_chatter@";
 
 class CliLive : public ::testing::Test {
  protected:
@@ -154,7 +156,7 @@ class CliLive : public ::testing::Test {
     ::close(ghost);
     // Let the stopped listener's queue fill and its entries pile up.
     ASSERT_TRUE(eventually([] {
-      const Outcome r = cli("topic info /chatter --json");
+      const Outcome r = cli("topic info " + topic + " --json");
       if (r.code != 0) return false;
       const json s = find_by(r.value()["subscribers"], "pid", stopped);
       return !s.is_null() && s["pending"] == 10 && s["unreceived"] == 10 && s["dropped"] > 0;
@@ -183,7 +185,7 @@ TEST_F(CliLive, TopicList) {
 }
 
 TEST_F(CliLive, TopicInfo) {
-  const Outcome r = cli("--json topic info /chatter");
+  const Outcome r = cli("--json topic info " + topic);
   ASSERT_EQ(r.code, 0) << r.err;
   const json info = r.value();
   EXPECT_EQ(info["name"], topic);
@@ -200,9 +202,9 @@ TEST_F(CliLive, TopicInfo) {
   ASSERT_FALSE(live.is_null());
   ASSERT_FALSE(frozen.is_null());
   EXPECT_EQ(live["node"], "listener");
-  EXPECT_EQ(live["queue"], "/chatter@" + live["id"].dump());
+  EXPECT_EQ(live["queue"], queue_prefix + live["id"].dump());
   EXPECT_EQ(frozen["node"], "stopped");
-  EXPECT_EQ(frozen["queue"], "/chatter@" + frozen["id"].dump());
+  EXPECT_EQ(frozen["queue"], queue_prefix + frozen["id"].dump());
   EXPECT_EQ(frozen["pending"], 10);  // a full queue: the talker never blocks on it
   EXPECT_EQ(frozen["unreceived"], 10);
   EXPECT_GT(frozen["dropped"].get<int>(), 0);
@@ -210,9 +212,9 @@ TEST_F(CliLive, TopicInfo) {
     EXPECT_EQ(s.size(), 8u) << s.dump();
   }
 
-  const Outcome table = cli("topic info /chatter");
+  const Outcome table = cli("topic info " + topic);
   ASSERT_EQ(table.code, 0);
-  EXPECT_EQ(lines_of(table.out).at(0), "topic /chatter");
+  EXPECT_EQ(lines_of(table.out).at(0), "topic " + topic);
   const auto talker_row = row_starting(table.out, pub["id"].dump());
   ASSERT_EQ(talker_row.size(), 6u) << table.out;
   EXPECT_EQ(talker_row[1], std::to_string(talker));
@@ -227,7 +229,7 @@ TEST_F(CliLive, TopicInfo) {
 }
 
 TEST_F(CliLive, TopicHzMeasuresWithoutSubscribing) {
-  const Outcome r = cli("topic hz /chatter --window 2 --json");
+  const Outcome r = cli("topic hz " + topic + " --window 2 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const json hz = r.value();
   EXPECT_EQ(hz["name"], topic);
@@ -238,16 +240,16 @@ TEST_F(CliLive, TopicHzMeasuresWithoutSubscribing) {
   // nested containers are not counted), so bytes are a multiple of messages.
   EXPECT_GT(hz["bytes_per_s"].get<double>(), 0.0);
   EXPECT_EQ(hz["bytes"].get<std::uint64_t>() % hz["messages"].get<std::uint64_t>(), 0u);
-  EXPECT_EQ(cli("topic list --json").value()["topics"][0]["subscribers"], 2);
+  EXPECT_EQ(find_by(cli("topic list --json").value()["topics"], "name", topic)["subscribers"], 2);
 
-  const Outcome table = cli("topic hz /chatter --window 1");
+  const Outcome table = cli("topic hz " + topic + " --window 1");
   ASSERT_EQ(table.code, 0);
   EXPECT_EQ(row_starting(table.out, "name"), (std::vector<std::string>{"name", topic}));
   EXPECT_EQ(row_starting(table.out, "rate_hz").size(), 2u);
 }
 
 TEST_F(CliLive, QueueListShowsOwnersDepthsAndTheStaleGhost) {
-  const json info = cli("topic info /chatter --json").value();
+  const json info = cli("topic info " + topic + " --json").value();
   const json frozen = find_by(info["subscribers"], "pid", stopped);
   const Outcome r = cli("queue list --json");
   ASSERT_EQ(r.code, 0) << r.err;

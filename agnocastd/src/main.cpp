@@ -128,6 +128,8 @@ int run(const agnocastd::Config& config) {
       throw;
     }
     agnocastd::notify("STOPPING=1");
+    // Exits that raced the stop signal: nothing is left behind for the next start.
+    agnocastd::clean_exited_processes(supervisor);
     agnocastd::write_status(supervisor, /*running=*/false);
   }
   // The exit-record descriptor is closed now; it would keep the module busy.

@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "agnocast/inspect.hpp"
+#include "errno_error.hpp"
 #include "module_loader.hpp"
 #include "notify.hpp"
 #include "status_file.hpp"
@@ -20,10 +21,6 @@
 namespace agnocastd {
 
 namespace {
-
-[[noreturn]] void throw_errno(const char* what) {
-  throw std::system_error(errno, std::generic_category(), what);
-}
 
 sigset_t daemon_signals() {
   sigset_t signals;

@@ -12,16 +12,13 @@
 #include <system_error>
 
 #include "agnocast/naming.hpp"
+#include "errno_error.hpp"
 
 namespace agnocastd {
 
 namespace {
 
 constexpr long mqueue_magic = 0x19800202;  // MQUEUE_MAGIC from <linux/magic.h>
-
-[[noreturn]] void throw_errno(const std::string& what) {
-  throw std::system_error(errno, std::generic_category(), what);
-}
 
 void write_limit(const std::string& name, long value) {
   const std::string path = "/proc/sys/fs/mqueue/" + name;

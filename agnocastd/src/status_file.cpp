@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <system_error>
 
+#include "errno_error.hpp"
+
 namespace agnocastd {
 
 nlohmann::json status_json(const Status& status) {
@@ -24,12 +26,6 @@ nlohmann::json status_json(const Status& status) {
       {"shm_removed", status.counters.shm_removed},
   };
 }
-
-namespace {
-[[noreturn]] void throw_errno(const std::string& what) {
-  throw std::system_error(errno, std::generic_category(), what);
-}
-}  // namespace
 
 void write_status_file(const std::string& path, const nlohmann::json& status) {
   const std::filesystem::path target(path);

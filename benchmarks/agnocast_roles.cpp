@@ -107,6 +107,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
       message->t0_ns = now_ns();
       pub->publish(std::move(message));
       read_bytes(ack.read_fd, subscribers);
+      settle_between_messages();
     }
     return 0;
   });

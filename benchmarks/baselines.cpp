@@ -67,6 +67,7 @@ LatencyStats run_mqueue_floor(std::size_t count) {
       throw std::system_error(errno, std::generic_category(), "mqueue ping-pong");
     }
     one_way.push_back((now_ns() - t0) / 2);
+    settle_between_messages();
   }
   wait_for(echo);
   mq_close(ping);
@@ -110,6 +111,7 @@ LatencyStats run_unix_socket_copy(std::size_t size, std::size_t count) {
     write_all(fds[0], payload.data(), size);
     char ack = 0;
     read_all(fds[0], &ack, 1);
+    settle_between_messages();
   }
   close(fds[0]);
   std::vector<std::int64_t> latencies = receive_latencies(results.read_fd);

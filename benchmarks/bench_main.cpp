@@ -35,6 +35,11 @@ struct Plan {
   }
   std::size_t fanout_count() const { return smoke ? 3 : 100; }
   bool smoke = false;
+  std::vector<std::string> only;  // empty: every section
+
+  bool wants(const char* section) const {
+    return only.empty() || std::find(only.begin(), only.end(), section) != only.end();
+  }
 
   void make_smoke() {
     smoke = true;
@@ -82,20 +87,26 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
   report["machine"] = machine_json();
   report["smoke"] = plan.smoke;
 
-  std::cerr << "mqueue notification floor...\n";
-  auto floor = bench::run_mqueue_floor(plan.floor_count);
-  report["latency"]["mqueue_floor"]["1 B"] = stats_json(floor);
+  if (plan.wants("floor")) {
+    std::cerr << "mqueue notification floor...\n";
+    auto floor = bench::run_mqueue_floor(plan.floor_count);
+    report["latency"]["mqueue_floor"]["1 B"] = stats_json(floor);
+  }
 
   for (std::size_t size : plan.sizes) {
+    if (!plan.wants("latency")) break;
     std::string label = bench::format_size(size);
     std::cerr << "latency " << label << "...\n";
     auto agnocast = bench::run_agnocast_latency(size, plan.latency_count(size), 1);
     report["latency"]["agnocast"][label] = stats_json(bench::summarize(agnocast.front()));
+    if (!plan.wants("copy")) continue;
     auto copy = bench::run_unix_socket_copy(size, plan.latency_count(size));
     report["latency"]["unix_socket"][label] = stats_json(copy);
   }
 
-  if (auto iceoryx = bench::IceoryxRunner::start(iceoryx_role)) {
+  if (!plan.wants("iceoryx")) {
+    report["latency"]["iceoryx"] = nullptr;
+  } else if (auto iceoryx = bench::IceoryxRunner::start(iceoryx_role)) {
     for (std::size_t size : plan.iceoryx_sizes) {
       std::string label = bench::format_size(size);
       std::cerr << "iceoryx latency " << label << "...\n";
@@ -106,27 +117,33 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
     report["latency"]["iceoryx"] = nullptr;
   }
 
-  std::cerr << "throughput...\n";
-  auto throughput = bench::run_agnocast_throughput(64, plan.throughput_count);
-  report["throughput"] = {{"size_bytes", 64},
-                          {"published", throughput.published},
-                          {"received", throughput.received},
-                          {"messages_per_s", throughput.messages_per_s}};
+  if (plan.wants("throughput")) {
+    std::cerr << "throughput...\n";
+    auto throughput = bench::run_agnocast_throughput(64, plan.throughput_count);
+    report["throughput"] = {{"size_bytes", 64},
+                            {"published", throughput.published},
+                            {"received", throughput.received},
+                            {"messages_per_s", throughput.messages_per_s}};
+  }
 
   for (std::size_t subscribers : plan.fanouts) {
+    if (!plan.wants("fanout")) break;
     std::cerr << "fan-out to " << subscribers << " subscribers...\n";
     auto per_subscriber =
         bench::run_agnocast_latency(plan.fanout_size, plan.fanout_count(), subscribers);
     report["fanout"][std::to_string(subscribers)] = stats_json(last_delivery(per_subscriber));
   }
 
-  const auto& latency = report["latency"];
   auto p50 = [&](const char* who, const char* size) -> double {
-    const json& entry = latency[who];
+    if (!report.contains("latency") || !report["latency"].contains(who)) return 0;
+    const json& entry = report["latency"][who];
     if (entry.is_null() || !entry.contains(size)) return 0;
     return entry[size]["p50_us"].get<double>();
   };
-  auto fanout_p50 = [&](const char* n) { return report["fanout"][n]["p50_us"].get<double>(); };
+  auto fanout_p50 = [&](const char* n) -> double {
+    if (!report.contains("fanout") || !report["fanout"].contains(n)) return 0;
+    return report["fanout"][n]["p50_us"].get<double>();
+  };
   report["ratios"] = {
       {"size_flatness", ratio(p50("agnocast", "64 MiB"), p50("agnocast", "64 B"))},
       {"vs_iceoryx", ratio(p50("agnocast", "4 KiB"), p50("iceoryx", "4 KiB"))},
@@ -147,7 +164,10 @@ void print_table(const json& report) {
               report["machine"]["kernel"].get<std::string>().c_str());
   std::printf("\none-way latency, microseconds (p50 / p99)\n");
   std::printf("%-10s %-22s %-22s %-22s\n", "payload", "agnocast", "unix socket (copy)", "iceoryx");
-  for (const auto& [label, agnocast] : report["latency"]["agnocast"].items()) {
+  const json none = json::object();
+  const json& latency = report.contains("latency") ? report["latency"] : none;
+  const json& agnocast_latency = latency.contains("agnocast") ? latency["agnocast"] : none;
+  for (const auto& [label, agnocast] : agnocast_latency.items()) {
     auto cell = [&](const json& entry) {
       if (entry.is_null() || !entry.contains(label)) return std::string("-");
       char text[64];
@@ -155,19 +175,23 @@ void print_table(const json& report) {
                     entry[label]["p99_us"].get<double>());
       return std::string(text);
     };
-    std::printf("%-10s %-22s %-22s %-22s\n", label.c_str(), cell(report["latency"]["agnocast"]).c_str(),
-                cell(report["latency"]["unix_socket"]).c_str(),
-                cell(report["latency"]["iceoryx"]).c_str());
+    auto column = [&](const char* who) { return cell(latency.contains(who) ? latency[who] : none); };
+    std::printf("%-10s %-22s %-22s %-22s\n", label.c_str(), column("agnocast").c_str(),
+                column("unix_socket").c_str(), column("iceoryx").c_str());
   }
-  const json& floor = report["latency"]["mqueue_floor"]["1 B"];
-  std::printf("mqueue notification floor (1 B): %.1f / %.1f\n", floor["p50_us"].get<double>(),
-              floor["p99_us"].get<double>());
-  std::printf("\nthroughput (64 B): %.0f messages/s (%llu of %llu received)\n",
-              report["throughput"]["messages_per_s"].get<double>(),
-              report["throughput"]["received"].get<unsigned long long>(),
-              report["throughput"]["published"].get<unsigned long long>());
+  if (latency.contains("mqueue_floor")) {
+    const json& floor = latency["mqueue_floor"]["1 B"];
+    std::printf("mqueue notification floor (1 B): %.1f / %.1f\n", floor["p50_us"].get<double>(),
+                floor["p99_us"].get<double>());
+  }
+  if (report.contains("throughput")) {
+    std::printf("\nthroughput (64 B): %.0f messages/s (%llu of %llu received)\n",
+                report["throughput"]["messages_per_s"].get<double>(),
+                report["throughput"]["received"].get<unsigned long long>(),
+                report["throughput"]["published"].get<unsigned long long>());
+  }
   std::printf("\npublish to last delivery, 4 KiB, microseconds (p50 / p99)\n");
-  for (const auto& [subscribers, stats] : report["fanout"].items()) {
+  for (const auto& [subscribers, stats] : (report.contains("fanout") ? report["fanout"] : none).items()) {
     std::printf("%3s subscriber(s): %.1f / %.1f\n", subscribers.c_str(),
                 stats["p50_us"].get<double>(), stats["p99_us"].get<double>());
   }
@@ -189,10 +213,18 @@ int main(int argc, char** argv) {
   app.add_flag("--json", json_output, "print one JSON object instead of tables");
   app.add_flag("--smoke", smoke, "tiny counts: checks that every measurement works");
   app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
+  Plan plan;
+  std::vector<std::string> size_texts;
+  app.add_option("--only", plan.only, "run only these sections (default: all)")
+      ->check(CLI::IsMember({"floor", "latency", "copy", "iceoryx", "throughput", "fanout"}));
+  app.add_option("--sizes", size_texts, "payload sizes for the latency sections, e.g. 64 4K 1M");
   CLI11_PARSE(app, argc, argv);
 
-  Plan plan;
   if (smoke) plan.make_smoke();
+  if (!size_texts.empty()) {
+    plan.sizes.clear();
+    for (const auto& text : size_texts) plan.sizes.push_back(bench::parse_size(text));
+  }
   try {
     json report = run(plan, iceoryx_role);
     if (json_output) {

@@ -17,6 +17,12 @@ std::int64_t now_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
+void settle_between_messages() {
+  timespec pause{0, 500'000};
+  while (nanosleep(&pause, &pause) != 0 && errno == EINTR) {
+  }
+}
+
 namespace {
 std::uint8_t pattern_byte(std::uint64_t seq, std::size_t index) {
   return static_cast<std::uint8_t>((seq * 131 + index * 7 + (index >> 12)) & 0xff);

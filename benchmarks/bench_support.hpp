@@ -13,6 +13,11 @@ namespace agnocast::bench {
 // CLOCK_MONOTONIC in nanoseconds: one clock for every process on the machine.
 std::int64_t now_ns();
 
+// Pause between two measured messages, outside the measured interval, so the
+// receiver is back asleep (and its CPU idle) when the next one is sent: each
+// sample then measures a wake-up from sleep, not the tail of the last message.
+void settle_between_messages();
+
 // Payload bytes derived from the message sequence number, so a reader can tell
 // a whole, untouched message from a corrupted or reused one.
 void fill_payload(std::span<std::uint8_t> payload, std::uint64_t seq);

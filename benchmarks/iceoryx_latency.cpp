@@ -47,6 +47,7 @@ int run_publisher(std::size_t size, std::size_t count, int ready_fd, int ack_fd)
     header->t0_ns = bench::now_ns();
     publisher.publish(chunk);
     if (!bench::read_all(ack_fd, &byte, 1)) return 1;
+    bench::settle_between_messages();
   }
   return 0;
 }

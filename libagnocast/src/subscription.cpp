@@ -113,10 +113,13 @@ std::size_t SubscriptionBase::handle_wakeup() {
   State& state = *state_;
   std::lock_guard lock(state.receive_mutex);
   Runtime& runtime = state.endpoint->runtime();
-  state.queue->drain();
   std::array<ReceivedEntry, 32> entries;
   std::array<PoolGrant, 8> pools;
   std::size_t delivered = 0;
+  // Receive before draining the queue, so a callback runs after one system
+  // call; the drain comes after, followed by one more receive, so a
+  // notification the drain consumes never hides an entry.
+  bool drained = false;
   for (;;) {
     const ReceiveResult result = runtime.device().receive(state.endpoint->id(), entries, pools);
     std::vector<EntryReference*> references;
@@ -135,7 +138,10 @@ std::size_t SubscriptionBase::handle_wakeup() {
       for (std::size_t i = handed_out; i < references.size(); ++i) release(references[i]);
       throw;
     }
-    if (result.remaining == 0) break;
+    if (result.remaining > 0) continue;
+    if (drained) break;
+    state.queue->drain();
+    drained = true;
   }
   return delivered;
 }

@@ -4,7 +4,6 @@
 #include <exception>
 #include <string_view>
 
-#include "agnocast/errors.hpp"
 #include "commands.hpp"
 
 namespace agnocast::cli {

@@ -226,6 +226,8 @@ TEST(DaemonStatus, MissingOrGarbledFileMeansNotRunning) {
   EXPECT_FALSE(value["running"].get<bool>());
   EXPECT_FALSE(value["module_loaded"].get<bool>());
   EXPECT_TRUE(value["module_version"].is_null());
+  source.files["/typo.json"] = R"({"running":"yes","pid":50})";
+  EXPECT_FALSE(daemon_status_json(source, "/typo.json")["running"].get<bool>());
 }
 
 const json& check_named(const json& doctor, const std::string& name) {

@@ -21,7 +21,8 @@ std::optional<json> read_status(InspectionSource& source, const std::string& pat
   const std::optional<std::string> text = source.read_file(path);
   if (!text) return std::nullopt;
   json status = json::parse(*text, nullptr, /*allow_exceptions=*/false);
-  if (!status.is_object() || !status.contains("pid") || !status["pid"].is_number_integer()) {
+  if (!status.is_object() || !status.contains("pid") || !status["pid"].is_number_integer() ||
+      !status.contains("running") || !status["running"].is_boolean()) {
     return std::nullopt;
   }
   return status;
@@ -31,7 +32,7 @@ std::optional<json> read_status(InspectionSource& source, const std::string& pat
 // its lock file (beside the status file) exclusively; where that file cannot
 // be opened, its pid must be alive and, where /proc tells, be agnocastd.
 bool daemon_alive(InspectionSource& source, const json& status, const std::string& status_path) {
-  if (!status.value("running", false)) return false;
+  if (!status.at("running").get<bool>()) return false;
   const std::string lock = (std::filesystem::path(status_path).parent_path() /
                             std::filesystem::path(std::string(agnocastd::lock_path)).filename())
                                .string();

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <thread>
 
+#include "agnocast/errors.hpp"
 #include "agnocast/inspect.hpp"
 #include "agnocast/naming.hpp"
 #include "inspection_source.hpp"
@@ -18,9 +19,29 @@
 namespace agnocast::cli {
 namespace {
 
+// "X.Y.Z" from the module's MODULE_VERSION, nullopt when absent or malformed.
+std::optional<Version> sysfs_module_version() {
+  std::ifstream in("/sys/module/agnocast/version");
+  Version version;
+  char dot1 = 0, dot2 = 0;
+  if (in >> version.major >> dot1 >> version.minor >> dot2 >> version.patch && dot1 == '.' &&
+      dot2 == '.') {
+    return version;
+  }
+  return std::nullopt;
+}
+
 class SystemSource final : public InspectionSource {
  public:
-  std::optional<Version> module_version() override { return agnocast::module_version(); }
+  std::optional<Version> module_version() override {
+    try {
+      return agnocast::module_version();
+    } catch (const DeviceError&) {
+      // A user the device refuses can still read the version sysfs shows to all.
+      if (std::optional<Version> version = sysfs_module_version()) return version;
+      throw;
+    }
+  }
   std::vector<TopicSummary> list_topics() override { return agnocast::list_topics(); }
   std::optional<TopicInfo> topic_info(const std::string& topic) override {
     return agnocast::topic_info(topic);

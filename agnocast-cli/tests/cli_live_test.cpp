@@ -4,6 +4,7 @@
 // the exit codes 0/1/2, and, last, doctor failing once the module is removed.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -36,9 +37,20 @@ std::string slurp(const std::string& path) {
   return text.str();
 }
 
-Outcome cli(const std::string& args) {
-  const int status = std::system(("agnocast-cli " + args + " >cli.out 2>cli.err").c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp("cli.out"), slurp("cli.err")};
+// Runs agnocast-cli ARGS through sh, as root or, with `uid`, as that user.
+Outcome cli(const std::string& args, uid_t uid = 0) {
+  const std::string out = "cli-" + std::to_string(uid) + ".out";
+  const std::string err = "cli-" + std::to_string(uid) + ".err";
+  const std::string command = "agnocast-cli " + args + " >" + out + " 2>" + err;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (uid != 0 && (::setgid(uid) != 0 || ::setuid(uid) != 0)) ::_exit(126);
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
 
 pid_t spawn(const std::vector<std::string>& args, const std::string& log) {
@@ -160,7 +172,7 @@ class CliLive : public ::testing::Test {
       if (r.code != 0) return false;
       const json s = find_by(r.value()["subscribers"], "pid", stopped);
       return !s.is_null() && s["pending"] == 10 && s["unreceived"] == 10 && s["dropped"] > 0;
-    })) << slurp("cli.out");
+    })) << slurp("cli-0.out");
   }
 
   static void TearDownTestSuite() {
@@ -306,6 +318,23 @@ TEST_F(CliLive, NodeListGroupsByProcess) {
             (std::vector<std::string>{"talker", std::to_string(talker), topic, "-"}));
   EXPECT_EQ(row_starting(table.out, "listener"),
             (std::vector<std::string>{"listener", std::to_string(listener), "-", topic}));
+}
+
+TEST_F(CliLive, AnUnprivilegedUserInspectsWhatItMayOpen) {
+  ::chmod(".", 0777);  // that user writes its output files here
+  constexpr uid_t nobody = 65534;
+  const Outcome list = cli("topic list --json", nobody);
+  ASSERT_EQ(list.code, 0) << list.err;
+  EXPECT_FALSE(find_by(list.value()["topics"], "name", topic).is_null());
+  EXPECT_EQ(cli("topic info " + topic + " --json", nobody).code, 0);
+  // The ghost queue is root's, mode 0600: shown, its depth unknown to this user.
+  const Outcome queues = cli("queue list --json", nobody);
+  ASSERT_EQ(queues.code, 0) << queues.err;
+  const json ghost = find_by(queues.value()["queues"], "name", "/ghost@7");
+  EXPECT_TRUE(ghost["pending"].is_null()) << ghost.dump();
+  EXPECT_TRUE(ghost["capacity"].is_null());
+  EXPECT_EQ(ghost["stale"], true);
+  EXPECT_TRUE(cli("version --json", nobody).value()["module"].is_string());
 }
 
 TEST_F(CliLive, VersionReportsTheLoadedModule) {

@@ -10,7 +10,9 @@
 # which is on PATH.  TARGETS and FILES are further programs or data the test
 # needs, copied to the same place with every shared library they link.
 # The VM runs each test as root in a fresh /tmp/vm-tests/<NAME> directory with
-# agnocast.ko loaded (its path is $AGNOCAST_MODULE), one after another;
+# agnocast.ko freshly loaded with default parameters, default mqueue limits
+# and empty /dev/mqueue and /dev/shm (the module path is $AGNOCAST_MODULE),
+# one after another;
 # TIMEOUT (default 120 s) bounds one test.
 function(agnocast_add_vm_test)
   cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES")

@@ -201,8 +201,14 @@ void Runtime::map_pool(const PoolGrant& grant) {
 
 // The message functions of detail/message.hpp and allocator.hpp, over the runtime.
 
+namespace {
+thread_local std::uint64_t pool_bytes_allocated_by_this_thread = 0;
+}  // namespace
+
 void* pool_allocate(std::size_t bytes, std::size_t align) {
-  return Runtime::get().allocate(bytes, align);
+  void* memory = Runtime::get().allocate(bytes, align);
+  pool_bytes_allocated_by_this_thread += bytes;
+  return memory;
 }
 
 void pool_deallocate(void* ptr) noexcept {
@@ -212,7 +218,7 @@ void pool_deallocate(void* ptr) noexcept {
 namespace {
 
 constexpr std::size_t header_room = sizeof(MessageHeader);
-static_assert(header_room == Tlsf::alignment);
+static_assert(header_room % alignof(MessageHeader) == 0);
 
 MessageHeader* header_of(void* message) {
   return reinterpret_cast<MessageHeader*>(static_cast<char*>(message) - header_room);
@@ -225,8 +231,15 @@ void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void
   const std::size_t offset = (header_room + align - 1) & ~(align - 1);  // keeps message aligned
   void* block = Runtime::get().allocate(offset + size, align);
   void* message = static_cast<char*>(block) + offset;
-  *header_of(message) = MessageHeader{destroy, block};
+  *header_of(message) = MessageHeader{destroy, block, &pool_bytes_allocated_by_this_thread,
+                                      pool_bytes_allocated_by_this_thread};
   return message;
+}
+
+std::uint64_t published_bytes(void* message, std::size_t size) noexcept {
+  const MessageHeader& header = *header_of(message);
+  if (header.borrowing_thread_counter != &pool_bytes_allocated_by_this_thread) return size;
+  return size + (pool_bytes_allocated_by_this_thread - header.pool_bytes_at_borrow);
 }
 
 void free_message_memory(void* message) noexcept { pool_deallocate(header_of(message)->block); }

@@ -441,6 +441,20 @@ TEST(Lifecycle, AHeldMessageKeepsItsSubscriberUntilReleased) {
   EXPECT_EQ(info->subscribers.size(), 0U);
 }
 
+TEST(Counters, PublishedBytesCountThePayloadFilledIn) {
+  const std::string topic = unique_topic("bandwidth");
+  agnocast::Node node{"counter"};
+  auto publisher = node.create_publisher<Message>(topic, QoS{1});
+  publish(*publisher, 1, 64 * 1024);
+  publish(*publisher, 2, 64 * 1024);
+  const auto info = agnocast::topic_info(topic);
+  ASSERT_TRUE(info);
+  ASSERT_EQ(info->publishers.size(), 1U);
+  EXPECT_EQ(info->publishers[0].published, 2U);
+  EXPECT_GE(info->publishers[0].published_bytes, 2U * (64 * 1024 + sizeof(Message)));
+  EXPECT_LT(info->publishers[0].published_bytes, 2U * (2 * 64 * 1024 + sizeof(Message)));
+}
+
 TEST(Executors, MultiThreadedRunsEverySubscriptionAndCancels) {
   const std::string first_topic = unique_topic("mt_a"), second_topic = unique_topic("mt_b");
   agnocast::Node node{"mt"};

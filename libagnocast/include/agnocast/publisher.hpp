@@ -43,7 +43,7 @@ class Publisher {
       throw std::invalid_argument(
           "agnocast: publish needs a message from borrow_loaned_message() not yet published");
     }
-    core_.publish(loaned, sizeof(T));
+    core_.publish(loaned, detail::published_bytes(loaned, sizeof(T)));
   }
 
   const std::string& get_topic_name() const { return core_.topic(); }

@@ -15,6 +15,10 @@ namespace agnocast::detail {
 struct MessageHeader {
   void (*destroy)(void* message);
   void* block;  // the pool allocation that holds header and message
+  // For the bandwidth counter: which thread borrowed the message and how many
+  // pool bytes that thread had allocated by then.
+  const std::uint64_t* borrowing_thread_counter;
+  std::uint64_t pool_bytes_at_borrow;
 };
 
 template <class T>
@@ -24,6 +28,10 @@ void destroy_message_object(void* message) {
 
 // Pool memory for a message of size/align, header filled; returns the message address.
 void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*));
+// The message's size for the kernel's bandwidth counter: its own size plus
+// what the publishing thread allocated from the pool since borrowing it (the
+// vectors and strings filled in).  Just `size` when another thread borrowed it.
+std::uint64_t published_bytes(void* message, std::size_t size) noexcept;
 // Frees memory from allocate_message whose object was never constructed.
 void free_message_memory(void* message) noexcept;
 // Destroys a constructed, unpublished message and frees its memory.

@@ -63,7 +63,8 @@ void read_bytes(int fd, std::size_t count) {
 }  // namespace
 
 std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, std::size_t count,
-                                                            std::size_t subscribers) {
+                                                            std::size_t subscribers,
+                                                            std::size_t scratch_bytes) {
   const std::string topic = next_topic("latency");
   const std::size_t total = warmup_messages + count;
   Pipe ready = Pipe::open(), ack = Pipe::open();
@@ -99,10 +100,12 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
     agnocast::Node node{"bench_publisher"};
     auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{1});
     read_bytes(ready.read_fd, subscribers);
+    std::vector<std::uint8_t> scratch(scratch_bytes);
     for (std::size_t seq = 0; seq < total; ++seq) {
       auto message = pub->borrow_loaned_message();
       message->payload.resize(size);
       fill_payload(std::span(message->payload.data(), size), seq);
+      fill_payload(scratch, seq);
       message->seq = seq;
       message->t0_ns = now_ns();
       pub->publish(std::move(message));

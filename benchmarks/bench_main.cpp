@@ -104,6 +104,15 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
     report["latency"]["unix_socket"][label] = stats_json(copy);
   }
 
+  if (plan.wants("latency")) {
+    // The same 64 B message after writing 64 MiB elsewhere: how much of the
+    // growth with size is the caches the large write evicted.
+    std::cerr << "latency 64 B after a 64 MiB write...\n";
+    auto control = bench::run_agnocast_latency(64, plan.latency_count(64 << 20), 1, 64 << 20);
+    report["latency"]["agnocast_after_64_mib_write"]["64 B"] =
+        stats_json(bench::summarize(control.front()));
+  }
+
   if (!plan.wants("iceoryx")) {
     report["latency"]["iceoryx"] = nullptr;
   } else if (auto iceoryx = bench::IceoryxRunner::start(iceoryx_role)) {

@@ -2,7 +2,8 @@
 # agnocast-talker -> agnocast-listener across two processes, --json summary exact.
 set -eu
 topic=/examples/chatter_$$
-agnocast-listener --topic "$topic" --count 20 --timeout 60 --json >listener.json &
+# Depth 20 on both sides: a listener slower than the talker still loses none.
+agnocast-listener --topic "$topic" --count 20 --depth 20 --timeout 60 --json >listener.json &
 listener=$!
 # The listener's queue exists once it subscribed.
 mangled=$(echo "$topic" | cut -c2- | tr / _)
@@ -12,7 +13,7 @@ until ls /dev/mqueue | grep -q "^$mangled@"; do
   [ "$tries" -lt 200 ] || { echo "listener never subscribed"; exit 1; }
   sleep 0.05
 done
-agnocast-talker --topic "$topic" --count 20 --rate 0 --size 100000
+agnocast-talker --topic "$topic" --count 20 --depth 20 --rate 0 --size 100000
 wait "$listener"
 cat listener.json
 grep -qx '{"received":20,"corrupt":0,"first_seq":0,"last_seq":19,"missed":0,"max_size":100000}' listener.json

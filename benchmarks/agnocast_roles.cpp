@@ -1,9 +1,11 @@
 #include "agnocast_roles.hpp"
 
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <agnocast/agnocast.hpp>
+#include <atomic>
 #include <cerrno>
 #include <iostream>
 #include <span>
@@ -68,6 +70,12 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   const std::string topic = next_topic("latency");
   const std::size_t total = warmup_messages + count;
   Pipe ready = Pipe::open(), ack = Pipe::open();
+  // Subscribers count their deliveries here and only the last one acks, so
+  // the benchmark's own bookkeeping does not compete with deliveries.
+  void* shared = mmap(nullptr, sizeof(std::atomic<std::uint32_t>), PROT_READ | PROT_WRITE,
+                      MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (shared == MAP_FAILED) throw std::runtime_error("mmap failed");
+  auto* delivered = new (shared) std::atomic<std::uint32_t>(0);
   std::vector<Pipe> results;
   std::vector<pid_t> subscriber_pids;
   for (std::size_t s = 0; s < subscribers; ++s) {
@@ -84,8 +92,10 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
             bool intact = m->payload.size() == size &&
                           payload_intact(std::span(m->payload.data(), m->payload.size()), m->seq);
             latencies.push_back(intact ? t1 - m->t0_ns : -1);
-            char byte = 1;
-            write_all(ack.write_fd, &byte, 1);
+            if (delivered->fetch_add(1) + 1 == subscribers) {
+              char byte = 1;
+              write_all(ack.write_fd, &byte, 1);
+            }
             if (latencies.size() == total) executor.cancel();
           });
       executor.add_node(node);
@@ -107,9 +117,10 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
       fill_payload(std::span(message->payload.data(), size), seq);
       fill_payload(scratch, seq);
       message->seq = seq;
+      delivered->store(0);
       message->t0_ns = now_ns();
       pub->publish(std::move(message));
-      read_bytes(ack.read_fd, subscribers);
+      read_bytes(ack.read_fd, 1);
       settle_between_messages();
     }
     return 0;
@@ -129,6 +140,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   }
   reap(publisher, "publisher");
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
+  munmap(shared, sizeof(std::atomic<std::uint32_t>));
   return per_subscriber;
 }
 

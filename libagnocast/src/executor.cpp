@@ -47,15 +47,15 @@ void watch(int epoll_fd, int fd, std::uint64_t key, std::uint32_t events, int op
   }
 }
 
-constexpr std::uint32_t subscription_events = EPOLLIN | EPOLLONESHOT;
 
 }  // namespace
 
 struct Executor::State {
   enum class Outcome { handled, idle, stop };
 
-  State()
-      : epoll_fd(::epoll_create1(EPOLL_CLOEXEC)),
+  explicit State(bool parallel)
+      : subscription_events(parallel ? EPOLLIN | EPOLLONESHOT : EPOLLIN),
+        epoll_fd(::epoll_create1(EPOLL_CLOEXEC)),
         cancel_fd(make_eventfd()),
         change_fd(make_eventfd()) {
     if (epoll_fd < 0) throw Error(std::string("agnocast: epoll_create1: ") + std::strerror(errno));
@@ -103,14 +103,16 @@ struct Executor::State {
     // Re-arm even when a callback throws, or the subscription would go deaf.
     struct Rearm {
       int epoll_fd;
+      std::uint32_t events;
       const detail::SubscriptionBase& subscription;
       ~Rearm() {
+        if (!(events & EPOLLONESHOT)) return;
         epoll_event event{};
-        event.events = subscription_events;
+        event.events = events;
         event.data.u64 = subscription.key();
         ::epoll_ctl(epoll_fd, EPOLL_CTL_MOD, subscription.queue_fd(), &event);
       }
-    } rearm{epoll_fd, *subscription};
+    } rearm{epoll_fd, subscription_events, *subscription};
     subscription->handle_wakeup();
     return Outcome::handled;
   }
@@ -126,6 +128,7 @@ struct Executor::State {
     return handle(event.data.u64);
   }
 
+  const std::uint32_t subscription_events;
   const int epoll_fd;
   const int cancel_fd;
   const int change_fd;
@@ -134,7 +137,7 @@ struct Executor::State {
   std::map<std::uint64_t, std::weak_ptr<detail::SubscriptionBase>> armed;
 };
 
-Executor::Executor() : state_(std::make_unique<State>()) {}
+Executor::Executor(bool parallel) : state_(std::make_unique<State>(parallel)) {}
 Executor::~Executor() = default;
 
 void Executor::add_node(Node& node) {
@@ -200,7 +203,8 @@ void SingleThreadedExecutor::spin() {
 }
 
 MultiThreadedExecutor::MultiThreadedExecutor(std::size_t threads)
-    : threads_(threads ? threads : std::max(2U, std::thread::hardware_concurrency())) {}
+    : Executor(/*parallel=*/true),
+      threads_(threads ? threads : std::max(2U, std::thread::hardware_concurrency())) {}
 
 void MultiThreadedExecutor::spin() {
   begin_spin();

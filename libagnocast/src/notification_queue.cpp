@@ -51,6 +51,7 @@ OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
     : name_(name), descriptor_(-1), owner_pid_(::getpid()) {
   mq_attr attributes{};
   attributes.mq_maxmsg = std::min(static_cast<long>(depth), system_msg_max());
+  capacity_ = static_cast<std::size_t>(attributes.mq_maxmsg);
   attributes.mq_msgsize = sizeof(MqMsgAgnocast);
   const int flags = O_RDONLY | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
   // Mode 0666 lets publishers of any user notify us; the umask still applies.
@@ -74,9 +75,15 @@ OwnedQueue::~OwnedQueue() {
   if (::getpid() == owner_pid_) ::mq_unlink(name_.c_str());
 }
 
-void OwnedQueue::drain() const {
+std::size_t OwnedQueue::drain() const {
   char buffer[sizeof(MqMsgAgnocast)];
-  while (::mq_receive(descriptor_, buffer, sizeof buffer, nullptr) >= 0 || errno == EINTR) {
+  std::size_t drained = 0;
+  for (;;) {
+    if (::mq_receive(descriptor_, buffer, sizeof buffer, nullptr) >= 0) {
+      ++drained;
+    } else if (errno != EINTR) {
+      return drained;
+    }
   }
 }
 

@@ -117,8 +117,10 @@ std::size_t SubscriptionBase::handle_wakeup() {
   std::array<PoolGrant, 8> pools;
   std::size_t delivered = 0;
   // Receive before draining the queue, so a callback runs after one system
-  // call; the drain comes after, followed by one more receive, so a
-  // notification the drain consumes never hides an entry.
+  // call.  The drain comes after, followed by one more receive unless it held
+  // a single notification: that one woke us, so its entry was in the first
+  // receive, and no publish came since (a queue of one slot may have refused
+  // a later notification, so it always receives again).
   bool drained = false;
   for (;;) {
     const ReceiveResult result = runtime.device().receive(state.endpoint->id(), entries, pools);
@@ -140,8 +142,9 @@ std::size_t SubscriptionBase::handle_wakeup() {
     }
     if (result.remaining > 0) continue;
     if (drained) break;
-    state.queue->drain();
+    const std::size_t notifications = state.queue->drain();
     drained = true;
+    if (notifications == 1 && state.queue->capacity() > 1) break;
   }
   return delivered;
 }

@@ -29,7 +29,9 @@ class Executor {
   void cancel();
 
  protected:
-  Executor();
+  // parallel: several threads spin at once, so each wake-up is handed to one
+  // thread only (and re-armed after), which costs a system call per wake-up.
+  explicit Executor(bool parallel);
   // One spinning thread's loop, shared by every thread of a spin().
   void spin_loop();
   // Clears an earlier cancel() so that a new spin() runs.
@@ -42,6 +44,7 @@ class Executor {
 
 class SingleThreadedExecutor : public Executor {
  public:
+  SingleThreadedExecutor() : Executor(/*parallel=*/false) {}
   void spin() override;
 };
 

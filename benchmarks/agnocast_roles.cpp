@@ -153,8 +153,7 @@ Throughput run_agnocast_throughput(std::size_t size, std::size_t count) {
     agnocast::SingleThreadedExecutor executor;
     agnocast::Node node{"bench_subscriber"};
     auto subscription = node.create_subscription<BenchMessage>(
-        topic, agnocast::QoS{1000},
-        [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
+        topic, agnocast::QoS{1000}, [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
           if (received++ == 0) first_t0 = m->t0_ns;
           // The newest message is never dropped, so the last one always arrives.
           if (m->seq == count - 1) {

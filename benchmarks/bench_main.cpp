@@ -56,7 +56,8 @@ json stats_json(const bench::LatencyStats& stats) {
 bench::LatencyStats last_delivery(const std::vector<std::vector<std::int64_t>>& per_subscriber) {
   std::vector<std::int64_t> slowest(per_subscriber.front().size(), 0);
   for (const auto& latencies : per_subscriber) {
-    for (std::size_t i = 0; i < slowest.size(); ++i) slowest[i] = std::max(slowest[i], latencies[i]);
+    for (std::size_t i = 0; i < slowest.size(); ++i)
+      slowest[i] = std::max(slowest[i], latencies[i]);
   }
   return bench::summarize(std::move(slowest));
 }
@@ -119,7 +120,8 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
     for (std::size_t size : plan.iceoryx_sizes) {
       std::string label = bench::format_size(size);
       std::cerr << "iceoryx latency " << label << "...\n";
-      report["latency"]["iceoryx"][label] = stats_json(iceoryx->measure(size, plan.latency_count(size)));
+      report["latency"]["iceoryx"][label] =
+          stats_json(iceoryx->measure(size, plan.latency_count(size)));
     }
   } else {
     std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
@@ -188,7 +190,9 @@ void print_table(const json& report) {
                     entry[label]["p99_us"].get<double>());
       return std::string(text);
     };
-    auto column = [&](const char* who) { return cell(latency.contains(who) ? latency[who] : none); };
+    auto column = [&](const char* who) {
+      return cell(latency.contains(who) ? latency[who] : none);
+    };
     std::printf("%-10s %-22s %-22s %-22s\n", label.c_str(), column("agnocast").c_str(),
                 column("unix_socket").c_str(), column("iceoryx").c_str());
   }
@@ -209,7 +213,8 @@ void print_table(const json& report) {
                 report["throughput"]["published"].get<unsigned long long>());
   }
   std::printf("\npublish to last delivery, 4 KiB, microseconds (p50 / p99)\n");
-  for (const auto& [subscribers, stats] : (report.contains("fanout") ? report["fanout"] : none).items()) {
+  for (const auto& [subscribers, stats] :
+       (report.contains("fanout") ? report["fanout"] : none).items()) {
     std::printf("%3s subscriber(s): %.1f / %.1f\n", subscribers.c_str(),
                 stats["p50_us"].get<double>(), stats["p99_us"].get<double>());
   }

@@ -21,7 +21,8 @@ std::optional<std::string> find_in_path(const std::string& program) {
   while (start <= dirs.size()) {
     std::size_t end = dirs.find(':', start);
     if (end == std::string::npos) end = dirs.size();
-    std::filesystem::path candidate = std::filesystem::path(dirs.substr(start, end - start)) / program;
+    std::filesystem::path candidate =
+        std::filesystem::path(dirs.substr(start, end - start)) / program;
     if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
     start = end + 1;
   }
@@ -80,11 +81,10 @@ LatencyStats IceoryxRunner::measure(std::size_t size, std::size_t count) {
   Pipe ready = Pipe::open(), ack = Pipe::open(), results = Pipe::open();
   auto fd = [](int value) { return std::to_string(value); };
   const std::string size_text = std::to_string(size), count_text = std::to_string(count + warmup);
-  pid_t subscriber =
-      exec_child({role_program_, "sub", "--size", size_text, "--count", count_text, "--ready-fd",
-                  fd(ready.write_fd), "--ack-fd", fd(ack.write_fd), "--results-fd",
-                  fd(results.write_fd)},
-                 false);
+  pid_t subscriber = exec_child(
+      {role_program_, "sub", "--size", size_text, "--count", count_text, "--ready-fd",
+       fd(ready.write_fd), "--ack-fd", fd(ack.write_fd), "--results-fd", fd(results.write_fd)},
+      false);
   pid_t publisher = exec_child({role_program_, "pub", "--size", size_text, "--count", count_text,
                                 "--ready-fd", fd(ready.read_fd), "--ack-fd", fd(ack.read_fd)},
                                false);

@@ -19,21 +19,30 @@ using namespace agnocast_test;
 namespace {
 
 const unsigned long kCommands[] = {
-    AGNOCAST_IOC_GET_VERSION,     AGNOCAST_IOC_REGISTER_PROCESS, AGNOCAST_IOC_UNREGISTER_PROCESS,
-    AGNOCAST_IOC_ADD_PUBLISHER,   AGNOCAST_IOC_REMOVE_PUBLISHER, AGNOCAST_IOC_ADD_SUBSCRIBER,
-    AGNOCAST_IOC_REMOVE_SUBSCRIBER, AGNOCAST_IOC_PUBLISH,        AGNOCAST_IOC_RECLAIM,
-    AGNOCAST_IOC_RECEIVE,         AGNOCAST_IOC_TAKE,             AGNOCAST_IOC_RELEASE,
-    AGNOCAST_IOC_LIST_TOPICS,     AGNOCAST_IOC_TOPIC_INFO,       AGNOCAST_IOC_LIST_PROCESSES,
+    AGNOCAST_IOC_GET_VERSION,
+    AGNOCAST_IOC_REGISTER_PROCESS,
+    AGNOCAST_IOC_UNREGISTER_PROCESS,
+    AGNOCAST_IOC_ADD_PUBLISHER,
+    AGNOCAST_IOC_REMOVE_PUBLISHER,
+    AGNOCAST_IOC_ADD_SUBSCRIBER,
+    AGNOCAST_IOC_REMOVE_SUBSCRIBER,
+    AGNOCAST_IOC_PUBLISH,
+    AGNOCAST_IOC_RECLAIM,
+    AGNOCAST_IOC_RECEIVE,
+    AGNOCAST_IOC_TAKE,
+    AGNOCAST_IOC_RELEASE,
+    AGNOCAST_IOC_LIST_TOPICS,
+    AGNOCAST_IOC_TOPIC_INFO,
+    AGNOCAST_IOC_LIST_PROCESSES,
 };
-const char *const kTopics[] = {"/a", "/a/b", "/a_b", "/chatter", "/x/y/z", "/x_y/z", "/q"};
+const char* const kTopics[] = {"/a", "/a/b", "/a_b", "/chatter", "/x/y/z", "/x_y/z", "/q"};
 
 // A page of scratch memory followed by an inaccessible page, so that
 // arguments can straddle into a fault.
 struct Arena {
-  uint8_t *base;
-  Arena()
-  {
-    base = static_cast<uint8_t *>(
+  uint8_t* base;
+  Arena() {
+    base = static_cast<uint8_t*>(
         mmap(nullptr, 3 * 4096, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
     mprotect(base + 2 * 4096, 4096, PROT_NONE);
   }
@@ -42,7 +51,7 @@ struct Arena {
 struct Worker {
   std::mt19937_64 rng;
   int dev;
-  Registration *reg;
+  Registration* reg;
   bool owns_registration;
   Arena arena;
   std::vector<Endpoint> pubs, subs;
@@ -51,76 +60,76 @@ struct Worker {
   uint64_t rnd(uint64_t n) { return n ? rng() % n : 0; }
   bool chance(int percent) { return rnd(100) < static_cast<uint64_t>(percent); }
 
-  void *bad_pointer()
-  {
+  void* bad_pointer() {
     switch (rnd(5)) {
-      case 0: return nullptr;
-      case 1: return reinterpret_cast<void *>(1 + rnd(4095));
-      case 2: return reinterpret_cast<void *>(0xffffffff81000000ull + rnd(1 << 20));
-      case 3: return arena.base + 2 * 4096 - rnd(64);  // straddles the guard page
-      default: return reinterpret_cast<void *>(0x7ffffffff000ull - rnd(1 << 20) * 8);
+      case 0:
+        return nullptr;
+      case 1:
+        return reinterpret_cast<void*>(1 + rnd(4095));
+      case 2:
+        return reinterpret_cast<void*>(0xffffffff81000000ull + rnd(1 << 20));
+      case 3:
+        return arena.base + 2 * 4096 - rnd(64);  // straddles the guard page
+      default:
+        return reinterpret_cast<void*>(0x7ffffffff000ull - rnd(1 << 20) * 8);
     }
   }
 
-  uint64_t some_ptr(size_t bytes)
-  {
+  uint64_t some_ptr(size_t bytes) {
     if (chance(10)) return uptr(bad_pointer());
     return uptr(arena.base + 4096 - std::min<size_t>(bytes, 4096) / 2 * rnd(2));
   }
 
-  uint32_t some_u32(uint32_t typical)
-  {
+  uint32_t some_u32(uint32_t typical) {
     switch (rnd(6)) {
-      case 0: return static_cast<uint32_t>(rng());
-      case 1: return 0;
-      case 2: return 0xffffffffu;
-      default: return static_cast<uint32_t>(rnd(typical + 1));
+      case 0:
+        return static_cast<uint32_t>(rng());
+      case 1:
+        return 0;
+      case 2:
+        return 0xffffffffu;
+      default:
+        return static_cast<uint32_t>(rnd(typical + 1));
     }
   }
 
-  Endpoint some_endpoint(const std::vector<Endpoint> &v)
-  {
+  Endpoint some_endpoint(const std::vector<Endpoint>& v) {
     if (v.empty() || chance(15)) return {some_u32(8), some_u32(8)};
     return v[rnd(v.size())];
   }
 
-  void garbage()
-  {
+  void garbage() {
     unsigned long cmd = kCommands[rnd(std::size(kCommands))];
     if (chance(10)) cmd = static_cast<unsigned long>(rng());
     if (chance(10)) cmd ^= 1ul << rnd(32);
-    void *arg;
+    void* arg;
     if (chance(40)) {
       arg = bad_pointer();
     } else {
-      for (int i = 0; i < 4096; i += 8) *reinterpret_cast<uint64_t *>(arena.base + i) = rng();
+      for (int i = 0; i < 4096; i += 8) *reinterpret_cast<uint64_t*>(arena.base + i) = rng();
       arg = arena.base + rnd(512);
     }
     ioctl(dev, cmd, arg);
   }
 
-  void add_endpoint(bool publisher)
-  {
+  void add_endpoint(bool publisher) {
     auto ep = endpoint(kTopics[rnd(std::size(kTopics))], 1 + rnd(chance(5) ? 1100 : 8),
                        static_cast<uint32_t>(rnd(chance(5) ? 16 : 4)));
     if (chance(5)) ep.node[rnd(sizeof(ep.node))] = static_cast<char>(rng());
-    if (ioc(dev, publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep))
-      return;
+    if (ioc(dev, publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep)) return;
     (publisher ? pubs : subs).push_back({ep.topic_handle, ep.id});
   }
 
-  void remove_endpoint(bool publisher)
-  {
-    auto &v = publisher ? pubs : subs;
+  void remove_endpoint(bool publisher) {
+    auto& v = publisher ? pubs : subs;
     Endpoint e = some_endpoint(v);
     agnocast_remove_endpoint rm{e.handle, e.id};
-    if (ioc(dev, publisher ? AGNOCAST_IOC_REMOVE_PUBLISHER : AGNOCAST_IOC_REMOVE_SUBSCRIBER,
-            &rm) == 0)
-      std::erase_if(v, [&](const Endpoint &x) { return x.handle == e.handle && x.id == e.id; });
+    if (ioc(dev, publisher ? AGNOCAST_IOC_REMOVE_PUBLISHER : AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm) ==
+        0)
+      std::erase_if(v, [&](const Endpoint& x) { return x.handle == e.handle && x.id == e.id; });
   }
 
-  void do_publish()
-  {
+  void do_publish() {
     Endpoint e = some_endpoint(pubs);
     agnocast_publish arg{};
     arg.topic_handle = e.handle;
@@ -135,11 +144,10 @@ struct Worker {
     ioctl(dev, AGNOCAST_IOC_PUBLISH, &arg);
   }
 
-  void close_pools(const agnocast_pool *pools, uint32_t n)
-  {
+  void close_pools(const agnocast_pool* pools, uint32_t n) {
     for (uint32_t i = 0; i < n; i++) {
       if (chance(20)) {
-        void *m = mmap(reinterpret_cast<void *>(pools[i].addr), 4096, PROT_READ,
+        void* m = mmap(reinterpret_cast<void*>(pools[i].addr), 4096, PROT_READ,
                        MAP_SHARED | MAP_FIXED_NOREPLACE, pools[i].fd, 0);
         if (m != MAP_FAILED) munmap(m, 4096);
       }
@@ -147,8 +155,7 @@ struct Worker {
     }
   }
 
-  void do_receive()
-  {
+  void do_receive() {
     Endpoint e = some_endpoint(subs);
     agnocast_entry ents[16];
     agnocast_pool pools[4];
@@ -164,8 +171,7 @@ struct Worker {
     close_pools(pools, arg.pool_count);
   }
 
-  void do_take()
-  {
+  void do_take() {
     Endpoint e = some_endpoint(subs);
     agnocast_take arg{};
     arg.topic_handle = e.handle;
@@ -175,16 +181,14 @@ struct Worker {
     close_pools(&arg.pool, arg.pool_count);
   }
 
-  void do_release()
-  {
+  void do_release() {
     Endpoint e = some_endpoint(subs);
     uint64_t id = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
     agnocast_release arg{e.handle, e.id, id};
     ioctl(dev, AGNOCAST_IOC_RELEASE, &arg);
   }
 
-  void introspect()
-  {
+  void introspect() {
     switch (rnd(4)) {
       case 0: {
         agnocast_list_topics arg{some_ptr(4096), some_u32(16), 0};
@@ -219,11 +223,14 @@ struct Worker {
     }
   }
 
-  void step()
-  {
+  void step() {
     switch (rnd(20)) {
-      case 0: garbage(); break;
-      case 1: garbage(); break;
+      case 0:
+        garbage();
+        break;
+      case 1:
+        garbage();
+        break;
       case 2:
         // Only the main thread re-registers; the other one may briefly use
         // a stale pool address, which the kernel must refuse cleanly.
@@ -235,42 +242,57 @@ struct Worker {
           if (chance(90)) reg->full(dev);
         }
         break;
-      case 3: add_endpoint(true); break;
+      case 3:
+        add_endpoint(true);
+        break;
       case 4:
-      case 5: add_endpoint(false); break;
-      case 6: remove_endpoint(true); break;
-      case 7: remove_endpoint(false); break;
+      case 5:
+        add_endpoint(false);
+        break;
+      case 6:
+        remove_endpoint(true);
+        break;
+      case 7:
+        remove_endpoint(false);
+        break;
       case 8:
       case 9:
       case 10:
-      case 11: do_publish(); break;
+      case 11:
+        do_publish();
+        break;
       case 12:
-      case 13: do_receive(); break;
-      case 14: do_take(); break;
+      case 13:
+        do_receive();
+        break;
+      case 14:
+        do_take();
+        break;
       case 15:
-      case 16: do_release(); break;
+      case 16:
+        do_release();
+        break;
       case 17: {
         agnocast_reclaim rc{some_ptr(4096), static_cast<uint32_t>(rnd(600)), 0, 0, 0};
         ioctl(dev, AGNOCAST_IOC_RECLAIM, &rc);
         break;
       }
-      default: introspect();
+      default:
+        introspect();
     }
   }
 };
 
 std::atomic<bool> stop_threads{false};
 
-void *thread_main(void *p)
-{
-  auto *w = static_cast<Worker *>(p);
+void* thread_main(void* p) {
+  auto* w = static_cast<Worker*>(p);
   while (!stop_threads.load(std::memory_order_relaxed)) w->step();
   return nullptr;
 }
 
 // A worker process: registers (usually), then two threads fuzz until killed.
-[[noreturn]] void worker_process(uint64_t seed)
-{
+[[noreturn]] void worker_process(uint64_t seed) {
   int dev = open_device();
   Registration reg;
   std::mt19937_64 rng(seed);
@@ -291,8 +313,7 @@ void *thread_main(void *p)
 
 }  // namespace
 
-int main(int argc, char **argv)
-{
+int main(int argc, char** argv) {
   const int seconds = argc > 1 ? std::atoi(argv[1]) : 30;
   const int nprocs = argc > 2 ? std::atoi(argv[2]) : 6;
   std::mt19937_64 rng(static_cast<uint64_t>(getpid()) * 7919 + time(nullptr));
@@ -338,7 +359,7 @@ int main(int argc, char **argv)
   std::printf("fuzz: %llu worker processes, %zu exit records, state %s\n",
               static_cast<unsigned long long>(spawned), records, clean ? "clean" : "LEFT OVER");
   if (!clean) {
-    for (const auto &p : list_processes(dev)) std::printf("  left: pid %d\n", p.pid);
+    for (const auto& p : list_processes(dev)) std::printf("  left: pid %d\n", p.pid);
     return 1;
   }
   return 0;

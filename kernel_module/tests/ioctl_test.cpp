@@ -1,7 +1,7 @@
 // Every command of the UAPI: each success path and each documented errno,
 // with outputs poisoned before the call and checked after.
-#include <sched.h>
 #include <poll.h>
+#include <sched.h>
 #include <sys/prctl.h>
 
 #include "test_util.h"
@@ -31,17 +31,15 @@ static_assert(sizeof(agnocast_process_info) == 32);
 static_assert(sizeof(agnocast_list_processes) == 16);
 static_assert(sizeof(agnocast_exit_record) == 272);
 
-void *const kBadPtr = reinterpret_cast<void *>(8);
+void* const kBadPtr = reinterpret_cast<void*>(8);
 
 class Device : public ::testing::Test {
  protected:
-  void SetUp() override
-  {
+  void SetUp() override {
     dev = open_device();
     ASSERT_GE(dev, 0) << strerror(errno);
   }
-  void TearDown() override
-  {
+  void TearDown() override {
     reg.drop();
     close(dev);
   }
@@ -51,33 +49,29 @@ class Device : public ::testing::Test {
   Registration reg;
 };
 
-TEST(Abi, VersionMacrosMatchModuleVersion)
-{
+TEST(Abi, VersionMacrosMatchModuleVersion) {
   EXPECT_EQ(AGNOCAST_VERSION_MAJOR, 0);
   EXPECT_EQ(AGNOCAST_IOC_MAGIC, 0xAC);
 }
 
-TEST_F(Device, GetVersion)
-{
+TEST_F(Device, GetVersion) {
   auto v = poisoned<agnocast_version>();
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_GET_VERSION, &v), 0);
   EXPECT_EQ(v.major, AGNOCAST_VERSION_MAJOR);
   EXPECT_EQ(v.minor, AGNOCAST_VERSION_MINOR);
   EXPECT_EQ(v.patch, AGNOCAST_VERSION_PATCH);
   EXPECT_EQ(v.reserved, 0u);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_GET_VERSION, static_cast<agnocast_version *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_GET_VERSION, static_cast<agnocast_version*>(kBadPtr)), -EFAULT);
 }
 
-TEST_F(Device, UnknownCommandIsEnotty)
-{
+TEST_F(Device, UnknownCommandIsEnotty) {
   int dummy = 0;
   EXPECT_EQ(ioc(dev, _IO(AGNOCAST_IOC_MAGIC, 99), &dummy), -ENOTTY);
   EXPECT_EQ(ioc(dev, _IOWR(AGNOCAST_IOC_MAGIC, 1, int), &dummy), -ENOTTY);
   EXPECT_EQ(ioc(dev, _IOR('x', 0, agnocast_version), &dummy), -ENOTTY);
 }
 
-TEST_F(Device, RegisterReservesSlotAndRepeats)
-{
+TEST_F(Device, RegisterReservesSlotAndRepeats) {
   auto r = poisoned<agnocast_register_process>();
   r.pool_fd = -1;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);
@@ -94,12 +88,11 @@ TEST_F(Device, RegisterReservesSlotAndRepeats)
   EXPECT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), 0);
 }
 
-TEST_F(Device, RegisterErrors)
-{
+TEST_F(Device, RegisterErrors) {
   auto r = poisoned<agnocast_register_process>();
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS,
-                static_cast<agnocast_register_process *>(kBadPtr)),
-            -EFAULT);
+  EXPECT_EQ(
+      ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, static_cast<agnocast_register_process*>(kBadPtr)),
+      -EFAULT);
   // Attaching before reserving.
   r.pool_fd = 0;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -ESRCH);
@@ -153,8 +146,7 @@ TEST_F(Device, RegisterErrors)
   EXPECT_EQ(r.pid, getpid());
 }
 
-TEST_F(Device, Unregister)
-{
+TEST_F(Device, Unregister) {
   EXPECT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), -ESRCH);
   registered();
   EXPECT_TRUE(process_listed(dev, getpid()));
@@ -165,8 +157,7 @@ TEST_F(Device, Unregister)
   EXPECT_EQ(add_publisher(dev, "/t", 1, &ep), -ESRCH);
 }
 
-TEST_F(Device, EndpointCommandsNeedRegistration)
-{
+TEST_F(Device, EndpointCommandsNeedRegistration) {
   Endpoint ep;
   EXPECT_EQ(add_publisher(dev, "/t", 1, &ep), -ESRCH);
   EXPECT_EQ(add_subscriber(dev, "/t", 1, &ep), -ESRCH);
@@ -184,8 +175,7 @@ TEST_F(Device, EndpointCommandsNeedRegistration)
   EXPECT_EQ(release(dev, {1, 0}, 0), -ESRCH);
 }
 
-TEST_F(Device, AddEndpointsShareIdsPerTopic)
-{
+TEST_F(Device, AddEndpointsShareIdsPerTopic) {
   registered();
   auto ep = endpoint("/chatter", 10, 0, "talker");
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), 0);
@@ -228,8 +218,7 @@ TEST_F(Device, AddEndpointsShareIdsPerTopic)
   EXPECT_EQ(subs[1].dropped, 0u);
 }
 
-TEST_F(Device, IdsNeverCollideAcrossMangledNames)
-{
+TEST_F(Device, IdsNeverCollideAcrossMangledNames) {
   registered();
   Endpoint a, b, c;
   ASSERT_EQ(add_subscriber(dev, "/a/b", 1, &a), 0);
@@ -248,11 +237,10 @@ TEST_F(Device, IdsNeverCollideAcrossMangledNames)
   EXPECT_EQ(c.id, 2u);
 }
 
-TEST_F(Device, AddEndpointRejectsBadInput)
-{
+TEST_F(Device, AddEndpointRejectsBadInput) {
   registered();
-  for (const char *name : {"", "a", "/", "//", "//a", "/a/", "/a//b", "/a-b", "/a b", "/a.b",
-                           "/\xc3\xa9", "a/b"}) {
+  for (const char* name :
+       {"", "a", "/", "//", "//a", "/a/", "/a//b", "/a-b", "/a b", "/a.b", "/\xc3\xa9", "a/b"}) {
     auto ep = endpoint(name, 1);
     EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL) << name;
     EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL) << name;
@@ -276,7 +264,7 @@ TEST_F(Device, AddEndpointRejectsBadInput)
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);
   ep = endpoint("/ok", 1, AGNOCAST_POLLING);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, static_cast<agnocast_add_endpoint *>(kBadPtr)),
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, static_cast<agnocast_add_endpoint*>(kBadPtr)),
             -EFAULT);
   // A 255-character name and the maximum depth are fine.
   std::string longest = "/" + std::string(254, 'x');
@@ -287,8 +275,7 @@ TEST_F(Device, AddEndpointRejectsBadInput)
   EXPECT_EQ(topic_info(dev, "/ok", &info), -ENOENT);
 }
 
-TEST_F(Device, TooManyEndpointsIsEnospc)
-{
+TEST_F(Device, TooManyEndpointsIsEnospc) {
   registered();
   Endpoint ep;
   for (int i = 0; i < AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX; i++)
@@ -299,8 +286,7 @@ TEST_F(Device, TooManyEndpointsIsEnospc)
   EXPECT_EQ(add_publisher(dev, "/crowd", 1, &ep), -ENOSPC);
 }
 
-TEST_F(Device, RemoveEndpoint)
-{
+TEST_F(Device, RemoveEndpoint) {
   registered();
   Endpoint pub, sub;
   ASSERT_EQ(add_publisher(dev, "/rm", 1, &pub), 0);
@@ -315,9 +301,9 @@ TEST_F(Device, RemoveEndpoint)
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), -ENOENT);
   rm = {pub.handle, pub.id};
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), -ENOENT);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER,
-                static_cast<agnocast_remove_endpoint *>(kBadPtr)),
-            -EFAULT);
+  EXPECT_EQ(
+      ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, static_cast<agnocast_remove_endpoint*>(kBadPtr)),
+      -EFAULT);
   // Another process may not remove ours.
   EXPECT_EQ(in_child([&] {
               Registration child;
@@ -345,8 +331,7 @@ TEST_F(Device, RemoveEndpoint)
   drain_exit_records(dev);
 }
 
-TEST_F(Device, PublishReceiveRelease)
-{
+TEST_F(Device, PublishReceiveRelease) {
   registered();
   Endpoint pub, cb, poll;
   ASSERT_EQ(add_publisher(dev, "/pr", 2, &pub), 0);
@@ -397,7 +382,7 @@ TEST_F(Device, PublishReceiveRelease)
   EXPECT_EQ(release(dev, cb, 0), -ENOENT);
   EXPECT_EQ(release(dev, {cb.handle, 99}, 1), -ENOENT);
   EXPECT_EQ(release(dev, {0, cb.id}, 1), -ENOENT);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RELEASE, static_cast<agnocast_release *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RELEASE, static_cast<agnocast_release*>(kBadPtr)), -EFAULT);
 
   // Entry 0 is still unreceived by the polling subscriber.  A third publish
   // pushes it out of the window of 2; the polling subscriber over its depth
@@ -410,8 +395,7 @@ TEST_F(Device, PublishReceiveRelease)
   EXPECT_EQ(subs[1].unreceived, 2u);
 }
 
-TEST_F(Device, PublishErrors)
-{
+TEST_F(Device, PublishErrors) {
   Endpoint pub;
   // Slot reserved but no pool attached yet: -EBUSY.
   ASSERT_EQ(reg.reserve(dev), 0);
@@ -431,7 +415,7 @@ TEST_F(Device, PublishErrors)
   arg.addr = reg.addr;
   arg.reserved = 1;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -EINVAL);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, static_cast<agnocast_publish *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, static_cast<agnocast_publish*>(kBadPtr)), -EFAULT);
 
   Endpoint s1, s2, sp;
   ASSERT_EQ(add_subscriber(dev, "/pe", 1, &s1), 0);
@@ -466,8 +450,7 @@ TEST_F(Device, PublishErrors)
   EXPECT_EQ(wake[1], s2.id);
 }
 
-TEST_F(Device, Reclaim)
-{
+TEST_F(Device, Reclaim) {
   registered();
   Endpoint pub;
   ASSERT_EQ(add_publisher(dev, "/rc", 1, &pub), 0);
@@ -479,7 +462,7 @@ TEST_F(Device, Reclaim)
   auto rc = poisoned<agnocast_reclaim>();
   rc.reserved = 1;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), -EINVAL);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, static_cast<agnocast_reclaim *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, static_cast<agnocast_reclaim*>(kBadPtr)), -EFAULT);
   rc.reserved = 0;
   rc.reclaim = uptr(kBadPtr);
   rc.reclaim_capacity = 2;
@@ -505,8 +488,7 @@ TEST_F(Device, Reclaim)
   EXPECT_EQ(addrs[0], reg.addr + 16);
 }
 
-TEST_F(Device, ReceiveErrors)
-{
+TEST_F(Device, ReceiveErrors) {
   registered();
   Endpoint pub, sub;
   ASSERT_EQ(add_publisher(dev, "/re", 1, &pub), 0);
@@ -522,7 +504,7 @@ TEST_F(Device, ReceiveErrors)
   arg.entry_capacity = 1;
   arg.pool_capacity = 1;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, &arg), -EINVAL);  // reserved poisoned
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, static_cast<agnocast_receive *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, static_cast<agnocast_receive*>(kBadPtr)), -EFAULT);
 
   ASSERT_EQ(publish(dev, pub, reg.addr), 0);
   arg.reserved = 0;
@@ -536,8 +518,7 @@ TEST_F(Device, ReceiveErrors)
   EXPECT_EQ(subs[0].held, 0u);
 }
 
-TEST_F(Device, TakeNewestPassesOverOlder)
-{
+TEST_F(Device, TakeNewestPassesOverOlder) {
   registered();
   Endpoint pub, sub;
   ASSERT_EQ(add_publisher(dev, "/tk", 1, &pub), 0);
@@ -583,18 +564,17 @@ TEST_F(Device, TakeNewestPassesOverOlder)
 
   take.subscriber_id = pub.id;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -ENOENT);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, static_cast<agnocast_take *>(kBadPtr)), -EFAULT);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, static_cast<agnocast_take*>(kBadPtr)), -EFAULT);
   EXPECT_EQ(release(dev, sub, 2), 0);
 }
 
-TEST_F(Device, TransientLocal)
-{
+TEST_F(Device, TransientLocal) {
   registered();
   Endpoint tl_pub, pub, tl_sub, sub;
   ASSERT_EQ(add_publisher(dev, "/tl", 3, &tl_pub, AGNOCAST_TRANSIENT_LOCAL), 0);
   ASSERT_EQ(add_publisher(dev, "/tl", 3, &pub), 0);
   for (int i = 0; i < 5; i++) {
-    ASSERT_EQ(publish(dev, tl_pub, reg.addr + 8 * i), 0);  // ids 0,2,4,6,8
+    ASSERT_EQ(publish(dev, tl_pub, reg.addr + 8 * i), 0);      // ids 0,2,4,6,8
     ASSERT_EQ(publish(dev, pub, reg.addr + 1024 + 8 * i), 0);  // ids 1,3,5,7,9
   }
   ASSERT_EQ(add_subscriber(dev, "/tl", 2, &tl_sub, AGNOCAST_TRANSIENT_LOCAL), 0);
@@ -609,8 +589,7 @@ TEST_F(Device, TransientLocal)
   EXPECT_TRUE(rr.entries.empty());
 }
 
-TEST_F(Device, Introspection)
-{
+TEST_F(Device, Introspection) {
   registered();
   Endpoint ep;
   ASSERT_EQ(add_publisher(dev, "/zeta", 1, &ep), 0);
@@ -643,7 +622,7 @@ TEST_F(Device, Introspection)
   lt.capacity = 2;
   lt.topics = uptr(kBadPtr);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), -EFAULT);
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, static_cast<agnocast_list_topics *>(kBadPtr)),
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, static_cast<agnocast_list_topics*>(kBadPtr)),
             -EFAULT);
 
   agnocast_topic_info info;
@@ -689,8 +668,7 @@ TEST_F(Device, Introspection)
             0);
 }
 
-TEST_F(Device, ExitRecordsReadErrors)
-{
+TEST_F(Device, ExitRecordsReadErrors) {
   drain_exit_records(dev);
   int fd = open_device(O_RDONLY | O_NONBLOCK);
   ASSERT_GE(fd, 0);
@@ -729,8 +707,7 @@ TEST_F(Device, ExitRecordsReadErrors)
   close(fd);
 }
 
-TEST_F(Device, ExitRecordsPollAndBlock)
-{
+TEST_F(Device, ExitRecordsPollAndBlock) {
   drain_exit_records(dev);
   int fd = open_device(O_RDONLY);
   struct pollfd pfd = {fd, POLLIN, 0};
@@ -749,8 +726,7 @@ TEST_F(Device, ExitRecordsPollAndBlock)
   close(fd);
 }
 
-TEST_F(Device, MovedToAnotherIpcNamespaceIsExdev)
-{
+TEST_F(Device, MovedToAnotherIpcNamespaceIsExdev) {
   EXPECT_EQ(in_child([&] {
               Registration r;
               if (r.reserve(dev)) return 10;

@@ -15,9 +15,8 @@ namespace {
 
 int delete_module() { return syscall(SYS_delete_module, "agnocast", O_NONBLOCK) ? -errno : 0; }
 
-int load_module(const std::string &params)
-{
-  const char *path = std::getenv("AGNOCAST_MODULE");
+int load_module(const std::string& params) {
+  const char* path = std::getenv("AGNOCAST_MODULE");
   if (!path) return -ENOENT;
   int fd = open(path, O_RDONLY | O_CLOEXEC);
   if (fd < 0) return -errno;
@@ -26,14 +25,12 @@ int load_module(const std::string &params)
   return ret;
 }
 
-bool device_exists()
-{
+bool device_exists() {
   struct stat st;
   return stat(AGNOCAST_DEVICE_PATH, &st) == 0 && S_ISCHR(st.st_mode);
 }
 
-std::string read_param(const char *name)
-{
+std::string read_param(const char* name) {
   std::ifstream in(std::string("/sys/module/agnocast/parameters/") + name);
   std::string value;
   in >> value;
@@ -41,8 +38,7 @@ std::string read_param(const char *name)
 }
 
 // Teardown of exited processes is asynchronous: retry for a while.
-int unload()
-{
+int unload() {
   int ret = -EAGAIN;
   eventually([&] { return (ret = delete_module()) == 0; });
   return ret;
@@ -50,8 +46,7 @@ int unload()
 
 bool refused(int ret) { return ret == -EAGAIN || ret == -EBUSY; }
 
-TEST(Module, Lifetime)
-{
+TEST(Module, Lifetime) {
   ASSERT_NE(std::getenv("AGNOCAST_MODULE"), nullptr);
   ASSERT_TRUE(device_exists());
   const std::string params = "pool_size=" + read_param("pool_size") +
@@ -94,11 +89,10 @@ TEST(Module, Lifetime)
   EXPECT_FALSE(device_exists());
 
   // Invalid parameters fail the load with -EINVAL.
-  for (const char *bad : {"pool_size=0", "pool_size=4097", "pool_count=0", "pool_count=100000",
-                          "pool_base=0x1000", "pool_base=0x40000000001",
-                          "pool_base=0x7fff00000000",
-                          "pool_size=18446744073709547520 pool_count=2",
-                          "pool_size=1099511627776 pool_count=1024"}) {
+  for (const char* bad :
+       {"pool_size=0", "pool_size=4097", "pool_count=0", "pool_count=100000", "pool_base=0x1000",
+        "pool_base=0x40000000001", "pool_base=0x7fff00000000",
+        "pool_size=18446744073709547520 pool_count=2", "pool_size=1099511627776 pool_count=1024"}) {
     EXPECT_EQ(load_module(bad), -EINVAL) << bad;
     EXPECT_FALSE(device_exists()) << bad;
   }

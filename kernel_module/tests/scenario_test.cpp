@@ -19,14 +19,12 @@ constexpr uint64_t kMagic = 0xC0DE000000000000ull;
 struct Pipe {
   int fd[2];
   Pipe() { EXPECT_EQ(pipe(fd), 0); }
-  ~Pipe()
-  {
+  ~Pipe() {
     close(fd[0]);
     close(fd[1]);
   }
   void notify() { EXPECT_EQ(write(fd[1], "x", 1), 1); }
-  bool wait()
-  {
+  bool wait() {
     char c;
     return read(fd[0], &c, 1) == 1;
   }
@@ -34,31 +32,27 @@ struct Pipe {
 
 class Scenario : public ::testing::Test {
  protected:
-  void SetUp() override
-  {
+  void SetUp() override {
     dev = open_device();
     ASSERT_GE(dev, 0);
     ASSERT_EQ(reg.full(dev), 0);
     drain_exit_records(dev);
   }
-  void TearDown() override
-  {
+  void TearDown() override {
     reg.drop();
     close(dev);
   }
 
-  void kill_and_reap(pid_t pid)
-  {
+  void kill_and_reap(pid_t pid) {
     kill(pid, SIGKILL);
     waitpid(pid, nullptr, 0);
     ASSERT_TRUE(eventually([&] { return !process_listed(dev, pid); }));
   }
 
   // Exit records of pid among those waiting now, in order.
-  std::vector<agnocast_exit_record> records_of(pid_t pid)
-  {
+  std::vector<agnocast_exit_record> records_of(pid_t pid) {
     std::vector<agnocast_exit_record> mine;
-    for (const auto &r : drain_exit_records(dev))
+    for (const auto& r : drain_exit_records(dev))
       if (r.pid == pid) mine.push_back(r);
     return mine;
   }
@@ -69,16 +63,15 @@ class Scenario : public ::testing::Test {
 
 // Child body: a registered publisher that writes kMagic + entry id at each
 // message and publishes until killed.
-[[noreturn]] void publisher_forever(const char *topic, uint32_t depth, Pipe *ready,
-                                    int after = 20)
-{
+[[noreturn]] void publisher_forever(const char* topic, uint32_t depth, Pipe* ready,
+                                    int after = 20) {
   int d = open_device();
   Registration r;
   Endpoint pub;
   if (r.full(d) || add_publisher(d, topic, depth, &pub)) _exit(10);
   for (uint64_t i = 0;; i++) {
     uint64_t off = (i % 4096) * 64;
-    auto *slot = reinterpret_cast<volatile uint64_t *>(r.addr + off);
+    auto* slot = reinterpret_cast<volatile uint64_t*>(r.addr + off);
     *slot = kMagic + i;  // entry ids of a fresh topic with one publisher are 0, 1, 2...
     PublishResult res;
     if (publish(d, pub, r.addr + off, &res)) _exit(11);
@@ -88,8 +81,7 @@ class Scenario : public ::testing::Test {
   }
 }
 
-TEST_F(Scenario, PublisherKilledMidStreamLeavesEntriesReadable)
-{
+TEST_F(Scenario, PublisherKilledMidStreamLeavesEntriesReadable) {
   Endpoint sub;
   ASSERT_EQ(add_subscriber(dev, "/kill_pub", 4, &sub), 0);
   Pipe ready;
@@ -125,12 +117,12 @@ TEST_F(Scenario, PublisherKilledMidStreamLeavesEntriesReadable)
   EXPECT_TRUE(after.pools.empty());  // a pool is handed over once
 
   // The dead publisher's memory is still there, read-only, at its address.
-  void *map = mmap(reinterpret_cast<void *>(pool.addr), pool.size, PROT_READ,
+  void* map = mmap(reinterpret_cast<void*>(pool.addr), pool.size, PROT_READ,
                    MAP_SHARED | MAP_FIXED_NOREPLACE, pool.fd, 0);
   ASSERT_NE(map, MAP_FAILED) << strerror(errno);
-  for (const auto *list : {&before.entries, &after.entries}) {
-    for (const auto &e : *list) {
-      EXPECT_EQ(*reinterpret_cast<const uint64_t *>(e.addr), kMagic + e.entry_id);
+  for (const auto* list : {&before.entries, &after.entries}) {
+    for (const auto& e : *list) {
+      EXPECT_EQ(*reinterpret_cast<const uint64_t*>(e.addr), kMagic + e.entry_id);
       EXPECT_EQ(release(dev, sub, e.entry_id), 0);
     }
   }
@@ -142,14 +134,13 @@ TEST_F(Scenario, PublisherKilledMidStreamLeavesEntriesReadable)
   auto recs = records_of(child);
   ASSERT_EQ(recs.size(), 1u);
   EXPECT_EQ(recs[0].kind, static_cast<uint32_t>(AGNOCAST_EXIT_PROCESS));
-  for (const auto &p : list_processes(dev))
+  for (const auto& p : list_processes(dev))
     if (p.pid == getpid()) {
       EXPECT_EQ(p.pools_mapped, 1u);
     }
 }
 
-TEST_F(Scenario, SubscriberKilledMidStreamReleasesEverything)
-{
+TEST_F(Scenario, SubscriberKilledMidStreamReleasesEverything) {
   Endpoint pub;
   ASSERT_EQ(add_publisher(dev, "/kill_sub", 2, &pub), 0);
   Pipe ready;
@@ -213,8 +204,7 @@ TEST_F(Scenario, SubscriberKilledMidStreamReleasesEverything)
   EXPECT_EQ(recs[1].kind, static_cast<uint32_t>(AGNOCAST_EXIT_PROCESS));
 }
 
-TEST_F(Scenario, ManyThreadsKilledTogether)
-{
+TEST_F(Scenario, ManyThreadsKilledTogether) {
   Pipe ready;
   pid_t child = fork();
   if (child == 0) {
@@ -223,11 +213,11 @@ TEST_F(Scenario, ManyThreadsKilledTogether)
     Endpoint sub;
     if (r.full(d) || add_subscriber(d, "/threads", 1, &sub)) _exit(10);
     std::vector<pthread_t> threads(6);
-    for (auto &t : threads)
+    for (auto& t : threads)
       pthread_create(
           &t, nullptr,
-          [](void *p) -> void * {
-            int fd = *static_cast<int *>(p);
+          [](void* p) -> void* {
+            int fd = *static_cast<int*>(p);
             for (;;) {
               agnocast_list_topics l{0, 0, 0};
               ioctl(fd, AGNOCAST_IOC_LIST_TOPICS, &l);
@@ -247,8 +237,7 @@ TEST_F(Scenario, ManyThreadsKilledTogether)
   EXPECT_EQ(recs[1].kind, static_cast<uint32_t>(AGNOCAST_EXIT_PROCESS));
 }
 
-TEST_F(Scenario, ForkedChildIsNotRegisteredAndDiesAlone)
-{
+TEST_F(Scenario, ForkedChildIsNotRegisteredAndDiesAlone) {
   Endpoint pub;
   ASSERT_EQ(add_publisher(dev, "/fork", 1, &pub), 0);
   // The child inherits the descriptor but not the registration.
@@ -286,7 +275,7 @@ TEST_F(Scenario, ForkedChildIsNotRegisteredAndDiesAlone)
   auto procs = list_processes(dev);
   ASSERT_EQ(procs.size(), 3u);
   pid_t grandchild = 0;
-  for (const auto &p : procs)
+  for (const auto& p : procs)
     if (p.pid != getpid() && p.pid != parent) grandchild = p.pid;
   ASSERT_NE(grandchild, 0);
   kill_and_reap(parent);
@@ -295,8 +284,7 @@ TEST_F(Scenario, ForkedChildIsNotRegisteredAndDiesAlone)
   ASSERT_TRUE(eventually([&] { return !process_listed(dev, grandchild); }));
 }
 
-TEST_F(Scenario, ExecDropsTheOldRegistration)
-{
+TEST_F(Scenario, ExecDropsTheOldRegistration) {
   pid_t child = fork();
   if (child == 0) {
     int d = open_device(O_RDWR);
@@ -327,8 +315,7 @@ TEST_F(Scenario, ExecDropsTheOldRegistration)
 
 // After exec: the inherited descriptor still works, but the registration is
 // gone; registering again succeeds.
-int exec_child(int fd)
-{
+int exec_child(int fd) {
   Endpoint ep;
   if (add_publisher(fd, "/exec", 1, &ep) != -ESRCH) return 20;
   agnocast_topic_info info;
@@ -339,8 +326,7 @@ int exec_child(int fd)
   return 0;
 }
 
-TEST_F(Scenario, ReceivedPoolIsReadOnly)
-{
+TEST_F(Scenario, ReceivedPoolIsReadOnly) {
   Endpoint sub;
   ASSERT_EQ(add_subscriber(dev, "/ro", 4, &sub), 0);
   Pipe ready;
@@ -354,32 +340,31 @@ TEST_F(Scenario, ReceivedPoolIsReadOnly)
 
   // The descriptor is read-only: no writable shared mapping, no upgrade.
   EXPECT_EQ(fcntl(pool.fd, F_GETFL) & O_ACCMODE, O_RDONLY);
-  void *w = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, pool.fd, 0);
+  void* w = mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, pool.fd, 0);
   EXPECT_EQ(w, MAP_FAILED);
   EXPECT_EQ(errno, EACCES);
-  void *map = mmap(reinterpret_cast<void *>(pool.addr), pool.size, PROT_READ,
+  void* map = mmap(reinterpret_cast<void*>(pool.addr), pool.size, PROT_READ,
                    MAP_SHARED | MAP_FIXED_NOREPLACE, pool.fd, 0);
-  ASSERT_EQ(map, reinterpret_cast<void *>(pool.addr)) << strerror(errno);
+  ASSERT_EQ(map, reinterpret_cast<void*>(pool.addr)) << strerror(errno);
   EXPECT_EQ(mprotect(map, 4096, PROT_READ | PROT_WRITE), -1);
   EXPECT_EQ(errno, EACCES);
   const uint64_t addr = rr.entries[0].addr;
-  EXPECT_EQ(*reinterpret_cast<const uint64_t *>(addr), kMagic + rr.entries[0].entry_id);
+  EXPECT_EQ(*reinterpret_cast<const uint64_t*>(addr), kMagic + rr.entries[0].entry_id);
 
   // A write faults.
   EXPECT_EQ(in_child([&] {
-              *reinterpret_cast<volatile uint64_t *>(addr) = 1;
+              *reinterpret_cast<volatile uint64_t*>(addr) = 1;
               return 0;
             }),
             128 + SIGSEGV);
-  EXPECT_EQ(*reinterpret_cast<const uint64_t *>(addr), kMagic + rr.entries[0].entry_id);
+  EXPECT_EQ(*reinterpret_cast<const uint64_t*>(addr), kMagic + rr.entries[0].entry_id);
   kill_and_reap(child);
-  EXPECT_EQ(*reinterpret_cast<const uint64_t *>(addr), kMagic + rr.entries[0].entry_id);
+  EXPECT_EQ(*reinterpret_cast<const uint64_t*>(addr), kMagic + rr.entries[0].entry_id);
   munmap(map, pool.size);
   close(pool.fd);
 }
 
-TEST(Namespace, IpcNamespacesAreIsolated)
-{
+TEST(Namespace, IpcNamespacesAreIsolated) {
   int dev = open_device();
   ASSERT_GE(dev, 0);
   Registration reg;
@@ -413,15 +398,14 @@ TEST(Namespace, IpcNamespacesAreIsolated)
   EXPECT_EQ(info.publisher_total, 2u);
   // The child's exit record went to its own namespace.
   EXPECT_TRUE(eventually([&] { return list_processes(dev).size() == 1; }));
-  for (const auto &r : drain_exit_records(dev)) EXPECT_NE(r.kind, 0u);
+  for (const auto& r : drain_exit_records(dev)) EXPECT_NE(r.kind, 0u);
   reg.drop();
   close(dev);
 }
 
 }  // namespace
 
-int main(int argc, char **argv)
-{
+int main(int argc, char** argv) {
   if (argc == 3 && std::string(argv[1]) == "--exec-child") return exec_child(std::atoi(argv[2]));
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();

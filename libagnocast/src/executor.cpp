@@ -47,7 +47,6 @@ void watch(int epoll_fd, int fd, std::uint64_t key, std::uint32_t events, int op
   }
 }
 
-
 }  // namespace
 
 struct Executor::State {

@@ -517,9 +517,10 @@ int agnocast_add_subscriber(void __user *uarg)
 	return agnocast_add_endpoint(uarg, false);
 }
 
-int agnocast_remove_publisher(void __user *uarg)
+static int agnocast_remove_endpoint(void __user *uarg, bool publisher)
 {
 	struct agnocast_remove_endpoint arg;
+	struct agnocast_subscriber *sub;
 	struct agnocast_publisher *pub;
 	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
@@ -530,37 +531,33 @@ int agnocast_remove_publisher(void __user *uarg)
 	ret = agnocast_enter(&ctx, true);
 	if (ret)
 		return ret;
-	ret = agnocast_publisher_lookup(&ctx, arg.topic_handle, arg.id, &pub);
-	if (!ret) {
-		topic = pub->topic;
-		agnocast_publisher_destroy(pub);
-		agnocast_topic_maybe_free(topic);
+	if (publisher) {
+		ret = agnocast_publisher_lookup(&ctx, arg.topic_handle, arg.id, &pub);
+		if (!ret) {
+			topic = pub->topic;
+			agnocast_publisher_destroy(pub);
+		}
+	} else {
+		ret = agnocast_subscriber_lookup(&ctx, arg.topic_handle, arg.id, &sub);
+		if (!ret) {
+			topic = sub->topic;
+			agnocast_subscriber_destroy(sub);
+		}
 	}
+	if (!ret)
+		agnocast_topic_maybe_free(topic);
 	agnocast_leave(&ctx);
 	return ret;
 }
 
+int agnocast_remove_publisher(void __user *uarg)
+{
+	return agnocast_remove_endpoint(uarg, true);
+}
+
 int agnocast_remove_subscriber(void __user *uarg)
 {
-	struct agnocast_remove_endpoint arg;
-	struct agnocast_subscriber *sub;
-	struct agnocast_topic *topic;
-	struct agnocast_ctx ctx;
-	int ret;
-
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
-		return -EFAULT;
-	ret = agnocast_enter(&ctx, true);
-	if (ret)
-		return ret;
-	ret = agnocast_subscriber_lookup(&ctx, arg.topic_handle, arg.id, &sub);
-	if (!ret) {
-		topic = sub->topic;
-		agnocast_subscriber_destroy(sub);
-		agnocast_topic_maybe_free(topic);
-	}
-	agnocast_leave(&ctx);
-	return ret;
+	return agnocast_remove_endpoint(uarg, false);
 }
 
 /*

@@ -27,6 +27,8 @@
 #define AGNOCAST_TOPICS_PER_NS_MAX 4096
 /* Unreferenced id spaces kept so that topic_local_ids are not reused soon. */
 #define AGNOCAST_DORMANT_ID_SPACES_MAX 1024
+/* Spare messages and held records a process keeps of each kind. */
+#define AGNOCAST_SPARES_MAX 16
 
 struct ipc_namespace;
 struct pid;
@@ -96,6 +98,11 @@ struct agnocast_proc {
 	unsigned int nr_given;
 	struct list_head reclaim;	/* freed entries of this process's pool */
 	unsigned int nr_reclaim;
+	/* Freed bookkeeping kept for reuse, so publish and receive rarely allocate. */
+	struct list_head spare_msgs;
+	struct list_head spare_held;
+	unsigned int nr_spare_msgs;
+	unsigned int nr_spare_held;
 };
 
 /* Names equal after mangling share one topic_local_id counter. */
@@ -180,6 +187,7 @@ struct agnocast_held {
 struct agnocast_ctx {
 	struct agnocast_ns *ns;
 	struct agnocast_proc *proc;	/* NULL if not registered */
+	bool ns_from_file;		/* ns is the open file's: no reference of our own */
 };
 
 /* agnocast_ns.c */
@@ -190,13 +198,13 @@ void agnocast_ns_put(struct agnocast_ns *ns);
 void agnocast_ns_exit(void);
 
 /* agnocast_process.c */
-int agnocast_enter(struct agnocast_ctx *ctx, bool registered);
+int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered);
 void agnocast_leave(struct agnocast_ctx *ctx);
 int agnocast_process_init(void);
 void agnocast_process_exit(void);
 void agnocast_exit_records_free(struct agnocast_ns *ns);
-int agnocast_register_process(void __user *uarg);
-int agnocast_unregister_process(void);
+int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_unregister_process(struct agnocast_ns *file_ns);
 ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
 				   size_t count, bool nonblock);
 
@@ -216,21 +224,21 @@ void agnocast_pool_drop_given(struct agnocast_proc *proc);
 void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
 void agnocast_id_spaces_free(struct agnocast_ns *ns);
-int agnocast_add_publisher(void __user *uarg);
-int agnocast_add_subscriber(void __user *uarg);
-int agnocast_remove_publisher(void __user *uarg);
-int agnocast_remove_subscriber(void __user *uarg);
-int agnocast_publish(void __user *uarg);
-int agnocast_reclaim(void __user *uarg);
-int agnocast_receive(void __user *uarg);
-int agnocast_take(void __user *uarg);
-int agnocast_release(void __user *uarg);
+int agnocast_add_publisher(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg);
 bool agnocast_topic_name_valid(const char *name);
 struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
 
 /* agnocast_introspect.c */
-int agnocast_list_topics(void __user *uarg);
-int agnocast_topic_info(void __user *uarg);
-int agnocast_list_processes(void __user *uarg);
+int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg);
 
 #endif /* _AGNOCAST_INTERNAL_H */

@@ -24,7 +24,7 @@ static int agnocast_topic_cmp(const void *a, const void *b)
 	return strcmp((*ta)->name, (*tb)->name);
 }
 
-int agnocast_list_topics(void __user *uarg)
+int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_topic_summary *summaries = NULL;
 	struct agnocast_topic **topics = NULL;
@@ -36,7 +36,7 @@ int agnocast_list_topics(void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, false);
+	ret = agnocast_enter(&ctx, file_ns, false);
 	if (ret)
 		return ret;
 
@@ -105,7 +105,7 @@ static void agnocast_subscriber_info_fill(struct agnocast_subscriber_info *out,
 	out->dropped = sub->dropped;
 }
 
-int agnocast_topic_info(void __user *uarg)
+int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct pid_namespace *pid_ns = task_active_pid_ns(current);
 	struct agnocast_subscriber_info *sub_infos = NULL;
@@ -125,7 +125,7 @@ int agnocast_topic_info(void __user *uarg)
 	if (arg->reserved || !memchr(arg->name, '\0', sizeof(arg->name)) ||
 	    !agnocast_topic_name_valid(arg->name))
 		goto out_free_arg;
-	ret = agnocast_enter(&ctx, false);
+	ret = agnocast_enter(&ctx, file_ns, false);
 	if (ret)
 		goto out_free_arg;
 
@@ -187,7 +187,7 @@ static int agnocast_process_info_cmp(const void *a, const void *b)
 	return (pa->pid > pb->pid) - (pa->pid < pb->pid);
 }
 
-int agnocast_list_processes(void __user *uarg)
+int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct pid_namespace *pid_ns = task_active_pid_ns(current);
 	struct agnocast_process_info *infos = NULL;
@@ -199,7 +199,7 @@ int agnocast_list_processes(void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, false);
+	ret = agnocast_enter(&ctx, file_ns, false);
 	if (ret)
 		return ret;
 

@@ -76,39 +76,40 @@ static int agnocast_get_version(void __user *uarg)
 
 static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long arg)
 {
+	struct agnocast_ns *ns = file->private_data;
 	void __user *uarg = (void __user *)arg;
 
 	switch (cmd) {
 	case AGNOCAST_IOC_GET_VERSION:
 		return agnocast_get_version(uarg);
 	case AGNOCAST_IOC_REGISTER_PROCESS:
-		return agnocast_register_process(uarg);
+		return agnocast_register_process(ns, uarg);
 	case AGNOCAST_IOC_UNREGISTER_PROCESS:
-		return agnocast_unregister_process();
+		return agnocast_unregister_process(ns);
 	case AGNOCAST_IOC_ADD_PUBLISHER:
-		return agnocast_add_publisher(uarg);
+		return agnocast_add_publisher(ns, uarg);
 	case AGNOCAST_IOC_REMOVE_PUBLISHER:
-		return agnocast_remove_publisher(uarg);
+		return agnocast_remove_publisher(ns, uarg);
 	case AGNOCAST_IOC_ADD_SUBSCRIBER:
-		return agnocast_add_subscriber(uarg);
+		return agnocast_add_subscriber(ns, uarg);
 	case AGNOCAST_IOC_REMOVE_SUBSCRIBER:
-		return agnocast_remove_subscriber(uarg);
+		return agnocast_remove_subscriber(ns, uarg);
 	case AGNOCAST_IOC_PUBLISH:
-		return agnocast_publish(uarg);
+		return agnocast_publish(ns, uarg);
 	case AGNOCAST_IOC_RECLAIM:
-		return agnocast_reclaim(uarg);
+		return agnocast_reclaim(ns, uarg);
 	case AGNOCAST_IOC_RECEIVE:
-		return agnocast_receive(uarg);
+		return agnocast_receive(ns, uarg);
 	case AGNOCAST_IOC_TAKE:
-		return agnocast_take(uarg);
+		return agnocast_take(ns, uarg);
 	case AGNOCAST_IOC_RELEASE:
-		return agnocast_release(uarg);
+		return agnocast_release(ns, uarg);
 	case AGNOCAST_IOC_LIST_TOPICS:
-		return agnocast_list_topics(uarg);
+		return agnocast_list_topics(ns, uarg);
 	case AGNOCAST_IOC_TOPIC_INFO:
-		return agnocast_topic_info(uarg);
+		return agnocast_topic_info(ns, uarg);
 	case AGNOCAST_IOC_LIST_PROCESSES:
-		return agnocast_list_processes(uarg);
+		return agnocast_list_processes(ns, uarg);
 	default:
 		return -ENOTTY;
 	}

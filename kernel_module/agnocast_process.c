@@ -223,13 +223,19 @@ void agnocast_process_exit(void)
 }
 
 /* Takes the namespace lock and finds the caller's registration. */
-int agnocast_enter(struct agnocast_ctx *ctx, bool registered)
+int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered)
 {
 	struct agnocast_proc *proc, *stale = NULL;
 	bool other_ns = false;
 
 	ctx->proc = NULL;
-	ctx->ns = agnocast_ns_get_current();
+	/*
+	 * The open file holds a reference on the state of the namespace it was
+	 * opened in; while the caller is still in that namespace, use it and
+	 * skip the global namespace list.
+	 */
+	ctx->ns_from_file = file_ns && agnocast_ns_key_matches(file_ns);
+	ctx->ns = ctx->ns_from_file ? file_ns : agnocast_ns_get_current();
 	if (!ctx->ns)
 		return -ENOMEM;
 	mutex_lock(&ctx->ns->lock);
@@ -258,7 +264,8 @@ int agnocast_enter(struct agnocast_ctx *ctx, bool registered)
 void agnocast_leave(struct agnocast_ctx *ctx)
 {
 	mutex_unlock(&ctx->ns->lock);
-	agnocast_ns_put(ctx->ns);
+	if (!ctx->ns_from_file)
+		agnocast_ns_put(ctx->ns);
 }
 
 static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *err)
@@ -290,6 +297,8 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 	INIT_LIST_HEAD(&proc->publishers);
 	INIT_LIST_HEAD(&proc->subscribers);
 	INIT_LIST_HEAD(&proc->reclaim);
+	INIT_LIST_HEAD(&proc->spare_msgs);
+	INIT_LIST_HEAD(&proc->spare_held);
 	list_add_tail(&proc->ns_node, &ns->procs);
 	ns->nr_procs++;
 
@@ -309,7 +318,7 @@ err_free_proc:
 	return NULL;
 }
 
-int agnocast_register_process(void __user *uarg)
+int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_register_process arg;
 	struct agnocast_ctx ctx;
@@ -320,7 +329,7 @@ int agnocast_register_process(void __user *uarg)
 	if (arg.pool_fd < -1)
 		return -EBADF;
 
-	ret = agnocast_enter(&ctx, false);
+	ret = agnocast_enter(&ctx, file_ns, false);
 	if (ret)
 		return ret;
 	if (arg.pool_fd == -1) {
@@ -344,12 +353,12 @@ int agnocast_register_process(void __user *uarg)
 	return 0;
 }
 
-int agnocast_unregister_process(void)
+int agnocast_unregister_process(struct agnocast_ns *file_ns)
 {
 	struct agnocast_ctx ctx;
 	int ret;
 
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	spin_lock(&agnocast_proc_table_lock);

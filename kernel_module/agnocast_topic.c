@@ -24,6 +24,9 @@
 
 #include "agnocast_internal.h"
 
+/* Entries (and pools) a RECEIVE handles without allocating; 4 keeps the frame small. */
+#define AGNOCAST_RECEIVE_SMALL 4
+
 static bool agnocast_str_terminated(const char *s, size_t size)
 {
 	return memchr(s, '\0', size) != NULL;
@@ -341,8 +344,10 @@ void agnocast_proc_drop_endpoints(struct agnocast_proc *proc)
 	}
 }
 
+/* Frees the reclaim list and the spares. */
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc)
 {
+	struct agnocast_held *held, *htmp;
 	struct agnocast_msg *msg, *tmp;
 
 	lockdep_assert_held(&proc->ns->lock);
@@ -350,6 +355,14 @@ void agnocast_proc_drop_reclaim(struct agnocast_proc *proc)
 		kfree(msg);
 	INIT_LIST_HEAD(&proc->reclaim);
 	proc->nr_reclaim = 0;
+	list_for_each_entry_safe(msg, tmp, &proc->spare_msgs, node)
+		kfree(msg);
+	INIT_LIST_HEAD(&proc->spare_msgs);
+	proc->nr_spare_msgs = 0;
+	list_for_each_entry_safe(held, htmp, &proc->spare_held, node)
+		kfree(held);
+	INIT_LIST_HEAD(&proc->spare_held);
+	proc->nr_spare_held = 0;
 }
 
 static int agnocast_publisher_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id,
@@ -406,7 +419,8 @@ static bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg
 	return !(publisher && (arg->flags & AGNOCAST_POLLING));
 }
 
-static int agnocast_add_endpoint(void __user *uarg, bool publisher)
+static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
+				 bool publisher)
 {
 	struct agnocast_add_endpoint __user *uendpoint = uarg;
 	struct agnocast_add_endpoint *arg;
@@ -424,7 +438,7 @@ static int agnocast_add_endpoint(void __user *uarg, bool publisher)
 	if (!agnocast_endpoint_args_valid(arg, publisher))
 		goto out_free_arg;
 
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		goto out_free_arg;
 	topic = agnocast_topic_get(ctx.ns, arg->topic);
@@ -507,17 +521,18 @@ out_free_arg:
 	return ret;
 }
 
-int agnocast_add_publisher(void __user *uarg)
+int agnocast_add_publisher(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	return agnocast_add_endpoint(uarg, true);
+	return agnocast_add_endpoint(file_ns, uarg, true);
 }
 
-int agnocast_add_subscriber(void __user *uarg)
+int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	return agnocast_add_endpoint(uarg, false);
+	return agnocast_add_endpoint(file_ns, uarg, false);
 }
 
-static int agnocast_remove_endpoint(void __user *uarg, bool publisher)
+static int agnocast_remove_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
+				    bool publisher)
 {
 	struct agnocast_remove_endpoint arg;
 	struct agnocast_subscriber *sub;
@@ -528,7 +543,7 @@ static int agnocast_remove_endpoint(void __user *uarg, bool publisher)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	if (publisher) {
@@ -550,14 +565,39 @@ static int agnocast_remove_endpoint(void __user *uarg, bool publisher)
 	return ret;
 }
 
-int agnocast_remove_publisher(void __user *uarg)
+int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	return agnocast_remove_endpoint(uarg, true);
+	return agnocast_remove_endpoint(file_ns, uarg, true);
 }
 
-int agnocast_remove_subscriber(void __user *uarg)
+int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	return agnocast_remove_endpoint(uarg, false);
+	return agnocast_remove_endpoint(file_ns, uarg, false);
+}
+
+static struct agnocast_msg *agnocast_msg_alloc(struct agnocast_proc *proc)
+{
+	struct agnocast_msg *msg;
+
+	lockdep_assert_held(&proc->ns->lock);
+	if (list_empty(&proc->spare_msgs))
+		return kzalloc(sizeof(*msg), GFP_KERNEL_ACCOUNT);
+	msg = list_first_entry(&proc->spare_msgs, struct agnocast_msg, node);
+	list_del(&msg->node);
+	proc->nr_spare_msgs--;
+	memset(msg, 0, sizeof(*msg));
+	return msg;
+}
+
+static void agnocast_msg_free(struct agnocast_proc *proc, struct agnocast_msg *msg)
+{
+	lockdep_assert_held(&proc->ns->lock);
+	if (proc->nr_spare_msgs >= AGNOCAST_SPARES_MAX) {
+		kfree(msg);
+		return;
+	}
+	list_add(&msg->node, &proc->spare_msgs);
+	proc->nr_spare_msgs++;
 }
 
 /*
@@ -584,14 +624,14 @@ static int agnocast_reclaim_out(struct agnocast_proc *proc, u64 ubuf, u32 capaci
 		if (!n--)
 			break;
 		list_del(&msg->node);
-		kfree(msg);
 		proc->nr_reclaim--;
+		agnocast_msg_free(proc, msg);
 	}
 	*pending = proc->nr_reclaim;
 	return 0;
 }
 
-int agnocast_publish(void __user *uarg)
+int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	u32 __user *wake_ids;
 	struct agnocast_publish arg;
@@ -608,7 +648,7 @@ int agnocast_publish(void __user *uarg)
 		return -EFAULT;
 	if (arg.reserved)
 		return -EINVAL;
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	ret = agnocast_publisher_lookup(&ctx, arg.topic_handle, arg.publisher_id, &pub);
@@ -627,7 +667,7 @@ int agnocast_publish(void __user *uarg)
 		goto out_leave;
 
 	ret = -ENOMEM;
-	msg = kzalloc(sizeof(*msg), GFP_KERNEL_ACCOUNT);
+	msg = agnocast_msg_alloc(ctx.proc);
 	if (!msg)
 		goto out_leave;
 
@@ -637,7 +677,7 @@ int agnocast_publish(void __user *uarg)
 		if (sub->flags & AGNOCAST_POLLING)
 			continue;
 		if (put_user(sub->id, wake_ids + wake_count)) {
-			kfree(msg);
+			agnocast_msg_free(ctx.proc, msg);
 			ret = -EFAULT;
 			goto out_leave;
 		}
@@ -677,7 +717,7 @@ out_leave:
 	return 0;
 }
 
-int agnocast_reclaim(void __user *uarg)
+int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_reclaim arg;
 	struct agnocast_ctx ctx;
@@ -687,7 +727,7 @@ int agnocast_reclaim(void __user *uarg)
 		return -EFAULT;
 	if (arg.reserved)
 		return -EINVAL;
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	ret = agnocast_reclaim_out(ctx.proc, arg.reclaim, arg.reclaim_capacity,
@@ -700,23 +740,41 @@ int agnocast_reclaim(void __user *uarg)
 	return 0;
 }
 
-static void agnocast_held_free_list(struct list_head *list)
+static void agnocast_held_free(struct agnocast_proc *proc, struct agnocast_held *held)
+{
+	lockdep_assert_held(&proc->ns->lock);
+	if (proc->nr_spare_held >= AGNOCAST_SPARES_MAX) {
+		kfree(held);
+		return;
+	}
+	list_add(&held->node, &proc->spare_held);
+	proc->nr_spare_held++;
+}
+
+static void agnocast_held_free_list(struct agnocast_proc *proc, struct list_head *list)
 {
 	struct agnocast_held *held, *tmp;
 
-	list_for_each_entry_safe(held, tmp, list, node)
-		kfree(held);
+	list_for_each_entry_safe(held, tmp, list, node) {
+		list_del(&held->node);
+		agnocast_held_free(proc, held);
+	}
 }
 
-static int agnocast_held_alloc_list(struct list_head *list, u32 n)
+static int agnocast_held_alloc_list(struct agnocast_proc *proc, struct list_head *list, u32 n)
 {
 	struct agnocast_held *held;
 
 	INIT_LIST_HEAD(list);
+	for (; n && proc->nr_spare_held; n--) {
+		held = list_first_entry(&proc->spare_held, struct agnocast_held, node);
+		list_move(&held->node, list);
+		proc->nr_spare_held--;
+	}
 	while (n--) {
 		held = kzalloc(sizeof(*held), GFP_KERNEL_ACCOUNT);
 		if (!held) {
-			agnocast_held_free_list(list);
+			agnocast_held_free_list(proc, list);
 			return -ENOMEM;
 		}
 		list_add(&held->node, list);
@@ -743,11 +801,15 @@ static void agnocast_entry_out(struct agnocast_entry *out, const struct agnocast
 	out->publisher_id = msg->publisher_id;
 }
 
-int agnocast_receive(void __user *uarg)
+int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	struct agnocast_mempool **pool_objs = NULL;
-	struct agnocast_entry *entries = NULL;
-	struct agnocast_pool *pools = NULL;
+	/* A wake-up usually finds one entry: small receives need no allocation. */
+	struct agnocast_mempool *pool_objs_small[AGNOCAST_RECEIVE_SMALL];
+	struct agnocast_entry entries_small[AGNOCAST_RECEIVE_SMALL];
+	struct agnocast_pool pools_small[AGNOCAST_RECEIVE_SMALL];
+	struct agnocast_mempool **pool_objs = pool_objs_small;
+	struct agnocast_entry *entries = entries_small;
+	struct agnocast_pool *pools = pools_small;
 	struct agnocast_subscriber *sub;
 	struct agnocast_receive arg;
 	struct agnocast_ctx ctx;
@@ -759,7 +821,7 @@ int agnocast_receive(void __user *uarg)
 		return -EFAULT;
 	if (arg.reserved || !arg.entry_capacity || !arg.pool_capacity)
 		return -EINVAL;
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	ret = agnocast_subscriber_lookup(&ctx, arg.topic_handle, arg.subscriber_id, &sub);
@@ -768,7 +830,7 @@ int agnocast_receive(void __user *uarg)
 
 	n = min(arg.entry_capacity, sub->nr_unreceived);
 	ret = -ENOMEM;
-	if (n) {
+	if (n > AGNOCAST_RECEIVE_SMALL) {
 		entries = kvmalloc_array(n, sizeof(*entries), GFP_KERNEL);
 		pools = kvmalloc_array(min(n, arg.pool_capacity), sizeof(*pools), GFP_KERNEL);
 		pool_objs = kvmalloc_array(min(n, arg.pool_capacity), sizeof(*pool_objs),
@@ -793,7 +855,7 @@ int agnocast_receive(void __user *uarg)
 		agnocast_entry_out(&entries[i], msg);
 	}
 	n = i;
-	ret = agnocast_held_alloc_list(&spare, n);
+	ret = agnocast_held_alloc_list(ctx.proc, &spare, n);
 	if (ret)
 		goto out_free;
 
@@ -822,17 +884,19 @@ int agnocast_receive(void __user *uarg)
 out_put_fds:
 	for (j = 0; j < nfds; j++)
 		put_unused_fd(pools[j].fd);
-	agnocast_held_free_list(&spare);
+	agnocast_held_free_list(ctx.proc, &spare);
 out_free:
-	kvfree(pool_objs);
-	kvfree(pools);
-	kvfree(entries);
+	if (entries != entries_small) {
+		kvfree(pool_objs);
+		kvfree(pools);
+		kvfree(entries);
+	}
 out_leave:
 	agnocast_leave(&ctx);
 	return ret;
 }
 
-int agnocast_take(void __user *uarg)
+int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_subscriber *sub;
 	struct agnocast_msg *msg = NULL;
@@ -844,7 +908,7 @@ int agnocast_take(void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	ret = agnocast_subscriber_lookup(&ctx, arg.topic_handle, arg.subscriber_id, &sub);
@@ -857,7 +921,7 @@ int agnocast_take(void __user *uarg)
 	arg.pool_count = 0;
 	if (sub->nr_unreceived) {
 		msg = agnocast_sub_unreceived(sub, sub->nr_unreceived - 1);
-		ret = agnocast_held_alloc_list(&spare, 1);
+		ret = agnocast_held_alloc_list(ctx.proc, &spare, 1);
 		if (ret)
 			goto out_leave;
 		give = agnocast_pool_needs_giving(ctx.proc, msg->pool);
@@ -889,13 +953,13 @@ out_put_fd:
 	if (give)
 		put_unused_fd(arg.pool.fd);
 out_free_spare:
-	agnocast_held_free_list(&spare);
+	agnocast_held_free_list(ctx.proc, &spare);
 out_leave:
 	agnocast_leave(&ctx);
 	return ret;
 }
 
-int agnocast_release(void __user *uarg)
+int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_subscriber *sub;
 	struct agnocast_release arg;
@@ -905,7 +969,7 @@ int agnocast_release(void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, true);
+	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
 	ret = agnocast_subscriber_lookup(&ctx, arg.topic_handle, arg.subscriber_id, &sub);
@@ -918,7 +982,7 @@ int agnocast_release(void __user *uarg)
 		list_del(&held->node);
 		sub->nr_held--;
 		agnocast_msg_unref(held->entry);
-		kfree(held);
+		agnocast_held_free(ctx.proc, held);
 		ret = 0;
 		break;
 	}

@@ -5,6 +5,8 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
 #include <string_view>
@@ -233,15 +235,17 @@ ReclaimResult Device::reclaim(std::span<std::uint64_t> reclaim) const {
 
 ReceiveResult Device::receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
                               std::span<PoolGrant> pools) const {
-  std::vector<agnocast_entry> raw_entries(entries.size());
-  std::vector<agnocast_pool> raw_pools(pools.size());
+  // On the stack: this runs for every wake-up.
+  std::array<agnocast_entry, receive_entries_max> raw_entries;
+  std::array<agnocast_pool, receive_pools_max> raw_pools;
   agnocast_receive argument{};
   argument.topic_handle = subscriber.topic_handle;
   argument.subscriber_id = subscriber.id;
   argument.entries = reinterpret_cast<std::uintptr_t>(raw_entries.data());
-  argument.entry_capacity = static_cast<std::uint32_t>(raw_entries.size());
+  argument.entry_capacity =
+      static_cast<std::uint32_t>(std::min(entries.size(), raw_entries.size()));
   argument.pools = reinterpret_cast<std::uintptr_t>(raw_pools.data());
-  argument.pool_capacity = static_cast<std::uint32_t>(raw_pools.size());
+  argument.pool_capacity = static_cast<std::uint32_t>(std::min(pools.size(), raw_pools.size()));
   if (int err = call(fd_, AGNOCAST_IOC_RECEIVE, &argument)) fail("RECEIVE", err);
   for (std::uint32_t i = 0; i < argument.entry_count; ++i) {
     entries[i] =

@@ -109,6 +109,9 @@ class Device {
   PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
                         std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim) const;
   ReclaimResult reclaim(std::span<std::uint64_t> reclaim) const;
+  // The most entries and pool grants one receive() returns; larger spans are not filled further.
+  static constexpr std::size_t receive_entries_max = 32;
+  static constexpr std::size_t receive_pools_max = 8;
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
                         std::span<PoolGrant> pools) const;
   TakeResult take(EndpointId subscriber) const;

@@ -113,8 +113,8 @@ std::size_t SubscriptionBase::handle_wakeup() {
   State& state = *state_;
   std::lock_guard lock(state.receive_mutex);
   Runtime& runtime = state.endpoint->runtime();
-  std::array<ReceivedEntry, 32> entries;
-  std::array<PoolGrant, 8> pools;
+  std::array<ReceivedEntry, Device::receive_entries_max> entries;
+  std::array<PoolGrant, Device::receive_pools_max> pools;
   std::size_t delivered = 0;
   // Receive before draining the queue, so a callback runs after one system
   // call.  The drain comes after, followed by one more receive unless it held
@@ -124,20 +124,20 @@ std::size_t SubscriptionBase::handle_wakeup() {
   bool drained = false;
   for (;;) {
     const ReceiveResult result = runtime.device().receive(state.endpoint->id(), entries, pools);
-    std::vector<EntryReference*> references;
+    std::array<EntryReference*, Device::receive_entries_max> references;
     for (std::uint32_t i = 0; i < result.entry_count; ++i) {
-      references.push_back(state.endpoint->reference_to(entries[i].entry_id, state.endpoint));
+      references[i] = state.endpoint->reference_to(entries[i].entry_id, state.endpoint);
     }
     std::size_t handed_out = 0;  // deliver() owns every reference it was given
     try {
       map_pools(runtime, std::span(pools.data(), result.pool_count));
-      while (handed_out < references.size()) {
+      while (handed_out < result.entry_count) {
         const std::size_t i = handed_out++;
         deliver(reinterpret_cast<const void*>(entries[i].addr), references[i]);
         ++delivered;
       }
     } catch (...) {
-      for (std::size_t i = handed_out; i < references.size(); ++i) release(references[i]);
+      for (std::size_t i = handed_out; i < result.entry_count; ++i) release(references[i]);
       throw;
     }
     if (result.remaining > 0) continue;

@@ -45,7 +45,7 @@ struct SocketFrame {
 
 }  // namespace
 
-LatencyStats run_mqueue_floor(std::size_t count) {
+std::vector<std::int64_t> run_mqueue_floor(std::size_t count) {
   mq_unlink(ping_queue);
   mq_unlink(pong_queue);
   mqd_t ping = open_queue(ping_queue);
@@ -85,10 +85,10 @@ LatencyStats run_mqueue_floor(std::size_t count) {
   mq_close(pong);
   mq_unlink(ping_queue);
   mq_unlink(pong_queue);
-  return summarize(std::move(one_way));
+  return one_way;
 }
 
-LatencyStats run_unix_socket_copy(std::size_t size, std::size_t count) {
+std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count) {
   int fds[2];
   if (socketpair(AF_UNIX, SOCK_STREAM, 0, fds) != 0) {
     throw std::system_error(errno, std::generic_category(), "socketpair");
@@ -131,7 +131,7 @@ LatencyStats run_unix_socket_copy(std::size_t size, std::size_t count) {
   for (std::int64_t latency : latencies) {
     if (latency < 0) throw std::runtime_error("unix socket baseline: a payload arrived corrupted");
   }
-  return summarize(std::move(latencies));
+  return latencies;
 }
 
 }  // namespace agnocast::bench

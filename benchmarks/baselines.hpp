@@ -8,10 +8,11 @@
 
 namespace agnocast::bench {
 
-// One-way time of a 1-byte POSIX message queue ping-pong (round trip / 2).
-LatencyStats run_mqueue_floor(std::size_t count);
+// One-way times (ns) of a 1-byte POSIX message queue ping-pong: send to
+// the receiver's return, the sender having just woken as a publisher has.
+std::vector<std::int64_t> run_mqueue_floor(std::size_t count);
 
-// Send start to receive end of `size` bytes over a Unix stream socket.
-LatencyStats run_unix_socket_copy(std::size_t size, std::size_t count);
+// Send start to receive end (ns) of `size` bytes over a Unix stream socket.
+std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count);
 
 }  // namespace agnocast::bench

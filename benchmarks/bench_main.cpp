@@ -9,7 +9,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "agnocast_roles.hpp"
 #include "baselines.hpp"
@@ -34,6 +36,7 @@ struct Plan {
     return size >= (16u << 20) ? 20 : 300;
   }
   std::size_t fanout_count() const { return smoke ? 3 : 100; }
+  std::size_t rounds = 3;  // latency and fan-out rounds; each takes a third of every series
   bool smoke = false;
   std::vector<std::string> only;  // empty: every section
 
@@ -43,6 +46,7 @@ struct Plan {
 
   void make_smoke() {
     smoke = true;
+    rounds = 1;
     floor_count = 20;
     throughput_count = 200;
   }
@@ -53,13 +57,14 @@ json stats_json(const bench::LatencyStats& stats) {
 }
 
 // Publish-to-last-delivery: for each message, the slowest subscriber's latency.
-bench::LatencyStats last_delivery(const std::vector<std::vector<std::int64_t>>& per_subscriber) {
+std::vector<std::int64_t> last_delivery(
+    const std::vector<std::vector<std::int64_t>>& per_subscriber) {
   std::vector<std::int64_t> slowest(per_subscriber.front().size(), 0);
   for (const auto& latencies : per_subscriber) {
     for (std::size_t i = 0; i < slowest.size(); ++i)
       slowest[i] = std::max(slowest[i], latencies[i]);
   }
-  return bench::summarize(std::move(slowest));
+  return slowest;
 }
 
 json machine_json() {
@@ -88,45 +93,52 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
   report["machine"] = machine_json();
   report["smoke"] = plan.smoke;
 
-  if (plan.wants("floor")) {
-    std::cerr << "mqueue notification floor...\n";
-    auto floor = bench::run_mqueue_floor(plan.floor_count);
-    report["latency"]["mqueue_floor"]["1 B"] = stats_json(floor);
-  }
+  // Latency is measured in rounds, each taking its share of every series, so
+  // a slow spell of the emulator falls on all series alike instead of on
+  // whichever ran during it; the ratios compare neighbours in time.
+  std::map<std::string, std::map<std::string, std::vector<std::int64_t>>> samples;
+  std::vector<std::pair<std::string, std::string>> order;  // first-seen order of the series
+  auto add = [&](const std::string& who, const std::string& label, std::vector<std::int64_t> more) {
+    auto [series, inserted] = samples[who].try_emplace(label);
+    if (inserted) order.emplace_back(who, label);
+    series->second.insert(series->second.end(), more.begin(), more.end());
+  };
+  auto share = [&](std::size_t count) { return (count + plan.rounds - 1) / plan.rounds; };
 
-  for (std::size_t size : plan.sizes) {
-    if (!plan.wants("latency")) break;
-    std::string label = bench::format_size(size);
-    std::cerr << "latency " << label << "...\n";
-    auto agnocast = bench::run_agnocast_latency(size, plan.latency_count(size), 1);
-    report["latency"]["agnocast"][label] = stats_json(bench::summarize(agnocast.front()));
-    if (!plan.wants("copy")) continue;
-    auto copy = bench::run_unix_socket_copy(size, plan.latency_count(size));
-    report["latency"]["unix_socket"][label] = stats_json(copy);
-  }
-
-  if (plan.wants("latency")) {
-    // The same 64 B message after writing 64 MiB elsewhere: how much of the
-    // growth with size is the caches the large write evicted.
-    std::cerr << "latency 64 B after a 64 MiB write...\n";
-    auto control = bench::run_agnocast_latency(64, plan.latency_count(64 << 20), 1, 64 << 20);
-    report["latency"]["agnocast_after_64_mib_write"]["64 B"] =
-        stats_json(bench::summarize(control.front()));
-  }
-
-  if (!plan.wants("iceoryx")) {
-    report["latency"]["iceoryx"] = nullptr;
-  } else if (auto iceoryx = bench::IceoryxRunner::start(iceoryx_role)) {
-    for (std::size_t size : plan.iceoryx_sizes) {
-      std::string label = bench::format_size(size);
-      std::cerr << "iceoryx latency " << label << "...\n";
-      report["latency"]["iceoryx"][label] =
-          stats_json(iceoryx->measure(size, plan.latency_count(size)));
-    }
-  } else {
+  std::optional<bench::IceoryxRunner> iceoryx =
+      plan.wants("iceoryx") ? bench::IceoryxRunner::start(iceoryx_role) : std::nullopt;
+  if (plan.wants("iceoryx") && !iceoryx) {
     std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
-    report["latency"]["iceoryx"] = nullptr;
   }
+  for (std::size_t round = 1; round <= plan.rounds; ++round) {
+    std::cerr << "latency round " << round << " of " << plan.rounds << "...\n";
+    if (plan.wants("floor")) {
+      add("mqueue_floor", "1 B", bench::run_mqueue_floor(share(plan.floor_count)));
+    }
+    for (std::size_t size : plan.sizes) {
+      if (!plan.wants("latency")) break;
+      const std::string label = bench::format_size(size);
+      const std::size_t count = share(plan.latency_count(size));
+      add("agnocast", label, bench::run_agnocast_latency(size, count, 1).front());
+      if (plan.wants("copy")) add("unix_socket", label, bench::run_unix_socket_copy(size, count));
+    }
+    if (plan.wants("latency")) {
+      // The same 64 B message after writing 64 MiB elsewhere: how much of the
+      // growth with size is the caches the large write evicted.
+      add("agnocast_after_64_mib_write", "64 B",
+          bench::run_agnocast_latency(64, share(plan.latency_count(64 << 20)), 1, 64 << 20)
+              .front());
+    }
+    for (std::size_t size : plan.iceoryx_sizes) {
+      if (!iceoryx) break;
+      add("iceoryx", bench::format_size(size),
+          iceoryx->measure(size, share(plan.latency_count(size))));
+    }
+  }
+  for (const auto& [who, label] : order) {
+    report["latency"][who][label] = stats_json(bench::summarize(samples[who][label]));
+  }
+  if (!iceoryx) report["latency"]["iceoryx"] = nullptr;
 
   if (plan.wants("throughput")) {
     std::cerr << "throughput...\n";
@@ -137,12 +149,21 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
                             {"messages_per_s", throughput.messages_per_s}};
   }
 
+  // Fan-out in rounds too, for the same reason as latency.
+  std::map<std::size_t, std::vector<std::int64_t>> fanout_samples;
+  for (std::size_t round = 1; round <= plan.rounds && plan.wants("fanout"); ++round) {
+    for (std::size_t subscribers : plan.fanouts) {
+      std::cerr << "fan-out to " << subscribers << " subscribers, round " << round << "...\n";
+      auto slowest = last_delivery(
+          bench::run_agnocast_latency(plan.fanout_size, share(plan.fanout_count()), subscribers));
+      auto& series = fanout_samples[subscribers];
+      series.insert(series.end(), slowest.begin(), slowest.end());
+    }
+  }
   for (std::size_t subscribers : plan.fanouts) {
-    if (!plan.wants("fanout")) break;
-    std::cerr << "fan-out to " << subscribers << " subscribers...\n";
-    auto per_subscriber =
-        bench::run_agnocast_latency(plan.fanout_size, plan.fanout_count(), subscribers);
-    report["fanout"][std::to_string(subscribers)] = stats_json(last_delivery(per_subscriber));
+    if (!fanout_samples.contains(subscribers)) continue;
+    report["fanout"][std::to_string(subscribers)] =
+        stats_json(bench::summarize(fanout_samples[subscribers]));
   }
 
   auto p50 = [&](const char* who, const char* size) -> double {

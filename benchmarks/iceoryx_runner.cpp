@@ -76,7 +76,7 @@ IceoryxRunner::~IceoryxRunner() {
   }
 }
 
-LatencyStats IceoryxRunner::measure(std::size_t size, std::size_t count) {
+std::vector<std::int64_t> IceoryxRunner::measure(std::size_t size, std::size_t count) {
   constexpr std::size_t warmup = 3;
   Pipe ready = Pipe::open(), ack = Pipe::open(), results = Pipe::open();
   auto fd = [](int value) { return std::to_string(value); };
@@ -98,7 +98,7 @@ LatencyStats IceoryxRunner::measure(std::size_t size, std::size_t count) {
     if (latency < 0) throw std::runtime_error("iceoryx: a payload arrived corrupted");
   }
   latencies.erase(latencies.begin(), latencies.begin() + warmup);
-  return summarize(std::move(latencies));
+  return latencies;
 }
 
 }  // namespace agnocast::bench

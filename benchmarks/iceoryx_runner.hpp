@@ -20,7 +20,8 @@ class IceoryxRunner {
   IceoryxRunner& operator=(const IceoryxRunner&) = delete;
   IceoryxRunner& operator=(IceoryxRunner&&) = delete;
 
-  LatencyStats measure(std::size_t size, std::size_t count);
+  // One-way latencies (ns) of `count` messages of `size` bytes.
+  std::vector<std::int64_t> measure(std::size_t size, std::size_t count);
 
  private:
   IceoryxRunner(std::string role_program, int roudi_pid)

@@ -13,7 +13,9 @@
  * agnocast_ns.users is incremented only under agnocast_ns_list_lock (or while
  * already nonzero by the holder of a user) and drops to 0 only under it, so a
  * state seen with users == 0 under agnocast_ns_list_lock has no lock holder
- * and may be read and freed without agnocast_ns.lock.
+ * and may be read and freed without agnocast_ns.lock.  An ioctl on a file
+ * opened in the caller's namespace borrows the file's user reference (held
+ * until release, which cannot run during the ioctl) instead of taking one.
  */
 #include <linux/bitmap.h>
 #include <linux/ipc_namespace.h>

@@ -589,15 +589,22 @@ static struct agnocast_msg *agnocast_msg_alloc(struct agnocast_proc *proc)
 	return msg;
 }
 
+/* Keeps @node on @spares for reuse unless @nr spares are kept already. */
+static bool agnocast_spare_keep(struct list_head *node, struct list_head *spares,
+				unsigned int *nr)
+{
+	if (*nr >= AGNOCAST_SPARES_MAX)
+		return false;
+	list_add(node, spares);
+	(*nr)++;
+	return true;
+}
+
 static void agnocast_msg_free(struct agnocast_proc *proc, struct agnocast_msg *msg)
 {
 	lockdep_assert_held(&proc->ns->lock);
-	if (proc->nr_spare_msgs >= AGNOCAST_SPARES_MAX) {
+	if (!agnocast_spare_keep(&msg->node, &proc->spare_msgs, &proc->nr_spare_msgs))
 		kfree(msg);
-		return;
-	}
-	list_add(&msg->node, &proc->spare_msgs);
-	proc->nr_spare_msgs++;
 }
 
 /*
@@ -743,12 +750,8 @@ int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
 static void agnocast_held_free(struct agnocast_proc *proc, struct agnocast_held *held)
 {
 	lockdep_assert_held(&proc->ns->lock);
-	if (proc->nr_spare_held >= AGNOCAST_SPARES_MAX) {
+	if (!agnocast_spare_keep(&held->node, &proc->spare_held, &proc->nr_spare_held))
 		kfree(held);
-		return;
-	}
-	list_add(&held->node, &proc->spare_held);
-	proc->nr_spare_held++;
 }
 
 static void agnocast_held_free_list(struct agnocast_proc *proc, struct list_head *list)

@@ -73,7 +73,6 @@ struct agnocast_mempool {
 	struct file *file;		/* read-only reopening; NULL until attached */
 	struct agnocast_proc *owner;	/* NULL once the owner is gone */
 	struct pid *owner_pid;
-	unsigned int mappers;		/* live processes given @file */
 	unsigned long entries;		/* live entries inside the pool */
 };
 
@@ -94,7 +93,7 @@ struct agnocast_proc {
 	struct list_head subscribers;
 	unsigned int nr_publishers;
 	unsigned int nr_subscribers;
-	unsigned long *given;		/* pool_count bits: pools handed over */
+	unsigned long *given;		/* pool_count bits: live pools handed over */
 	unsigned int nr_given;
 	struct list_head reclaim;	/* freed entries of this process's pool */
 	unsigned int nr_reclaim;

@@ -3,10 +3,15 @@
  * agnocast: pool slots and the pool files handed to subscribers.
  *
  * Slot i of a namespace is the range pool_base + i * pool_size, the same in
- * every process.  A slot is reused only once its pool is unreachable: its
- * owner is gone, no live process was given its file, and no entry lives in
- * it.  Otherwise a new owner could be given an address range that a
- * subscriber still has mapped.
+ * every process.  A slot is reused once its owner is gone and no entry lives
+ * in its pool: then nobody reads from it any more.  Subscribers may still map
+ * the old pool, but only at that range in their own address space, which a
+ * registered process never receives as its own slot (it has one already;
+ * libagnocast's fork child unmaps the views it inherited, and a process that
+ * kept one would fail to map its own pool there rather than alias it).
+ * Freeing a pool clears its bit in every process's given map, so a
+ * subscriber is handed the slot's next pool before it reads an entry there,
+ * and replaces its stale view.
  *
  * The owner attaches a tmpfs file; the kernel keeps only a read-only
  * reopening of it, so whoever receives it can never map the pool writable.
@@ -78,9 +83,15 @@ out_put:
 
 void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool)
 {
+	struct agnocast_proc *proc;
+
 	lockdep_assert_held(&ns->lock);
-	if (pool->owner || pool->mappers || pool->entries)
+	if (pool->owner || pool->entries)
 		return;
+	list_for_each_entry(proc, &ns->procs, ns_node) {
+		if (__test_and_clear_bit(pool->slot, proc->given))
+			proc->nr_given--;
+	}
 	clear_bit(pool->slot, ns->slot_map);
 	ns->slots[pool->slot] = NULL;
 	if (pool->file)
@@ -124,27 +135,14 @@ void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool
 {
 	lockdep_assert_held(&proc->ns->lock);
 	fd_install(fd, get_file(pool->file));
-	if (__test_and_set_bit(pool->slot, proc->given))
-		return;
-	pool->mappers++;
-	proc->nr_given++;
+	if (!__test_and_set_bit(pool->slot, proc->given))
+		proc->nr_given++;
 }
 
 /* Teardown: @proc no longer maps any pool it was given. */
 void agnocast_pool_drop_given(struct agnocast_proc *proc)
 {
-	struct agnocast_ns *ns = proc->ns;
-	struct agnocast_mempool *pool;
-	unsigned long slot;
-
-	lockdep_assert_held(&ns->lock);
-	for_each_set_bit(slot, proc->given, agnocast_pool_count) {
-		__clear_bit(slot, proc->given);
-		pool = ns->slots[slot];
-		if (WARN_ON_ONCE(!pool))
-			continue;
-		pool->mappers--;
-		agnocast_pool_maybe_free(ns, pool);
-	}
+	lockdep_assert_held(&proc->ns->lock);
+	bitmap_zero(proc->given, agnocast_pool_count);
 	proc->nr_given = 0;
 }

@@ -134,10 +134,68 @@ TEST_F(Scenario, PublisherKilledMidStreamLeavesEntriesReadable) {
   auto recs = records_of(child);
   ASSERT_EQ(recs.size(), 1u);
   EXPECT_EQ(recs[0].kind, static_cast<uint32_t>(AGNOCAST_EXIT_PROCESS));
+  // Owner gone and no entry left: the pool is freed, and no longer counted.
   for (const auto& p : list_processes(dev))
     if (p.pid == getpid()) {
-      EXPECT_EQ(p.pools_mapped, 1u);
+      EXPECT_EQ(p.pools_mapped, 0u);
     }
+}
+
+// A dead publisher's slot is free again once its entries are released, even
+// though a live subscriber still maps its pool; that subscriber is handed the
+// next pool of the slot before it reads an entry there.
+TEST_F(Scenario, DeadPublishersSlotIsReusedWhileSubscriberLives) {
+  auto mapped_by_us = [&] {
+    for (const auto& p : list_processes(dev))
+      if (p.pid == getpid()) return p.pools_mapped;
+    return ~0u;
+  };
+  void* view = nullptr;
+  uint64_t slot_addr = 0, slot_size = 0;
+  for (int generation = 0; generation < 2; generation++) {
+    // A fresh topic each time: publisher_forever expects entry ids from 0.
+    const std::string topic = "/slot_reuse_" + std::to_string(generation);
+    Endpoint sub;
+    ASSERT_EQ(add_subscriber(dev, topic.c_str(), 4, &sub), 0);
+    Pipe ready;
+    pid_t child = fork();
+    if (child == 0) {
+      // As the library's fork handler does: the parent's pool views are not ours.
+      if (view) munmap(view, slot_size);
+      publisher_forever(topic.c_str(), 1, &ready, 1);
+    }
+    ASSERT_TRUE(ready.wait());
+    ReceiveResult rr;
+    ASSERT_EQ(receive(dev, sub, &rr, 1), 0);
+    ASSERT_EQ(rr.entries.size(), 1u);
+    // Each generation's pool is handed over, the second one at the same slot.
+    ASSERT_EQ(rr.pools.size(), 1u) << "generation " << generation;
+    const agnocast_pool pool = rr.pools[0];
+    EXPECT_EQ(pool.pid, child);
+    if (generation == 0) {
+      slot_addr = pool.addr;
+      slot_size = pool.size;
+    }
+    EXPECT_EQ(pool.addr, slot_addr);
+    // The second mapping replaces the stale view of the first pool.
+    view = mmap(reinterpret_cast<void*>(pool.addr), pool.size, PROT_READ,
+                MAP_SHARED | (view ? MAP_FIXED : MAP_FIXED_NOREPLACE), pool.fd, 0);
+    ASSERT_EQ(view, reinterpret_cast<void*>(pool.addr)) << strerror(errno);
+    close(pool.fd);
+    const auto& entry = rr.entries[0];
+    EXPECT_EQ(*reinterpret_cast<const uint64_t*>(entry.addr), kMagic + entry.entry_id);
+    EXPECT_EQ(mapped_by_us(), 1u);
+
+    EXPECT_EQ(release(dev, sub, entry.entry_id), 0);
+    kill_and_reap(child);
+    // Nothing of the dead publisher is left unreceived or held.
+    ReceiveResult rest;
+    ASSERT_EQ(receive(dev, sub, &rest), 0);
+    for (const auto& e : rest.entries) EXPECT_EQ(release(dev, sub, e.entry_id), 0);
+    for (const auto& p : rest.pools) close(p.fd);
+    ASSERT_TRUE(eventually([&] { return mapped_by_us() == 0; }));
+  }
+  munmap(view, slot_size);
 }
 
 TEST_F(Scenario, SubscriberKilledMidStreamReleasesEverything) {

@@ -441,6 +441,68 @@ TEST(Lifecycle, AHeldMessageKeepsItsSubscriberUntilReleased) {
   EXPECT_EQ(info->subscribers.size(), 0U);
 }
 
+// A publisher dies and the next one gets its pool slot while the subscriber
+// lives on: the subscriber is handed the new pool, replaces its view of the
+// old one, and reads every new message whole.
+TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
+  const std::string topic = unique_topic("slot_reuse");
+  agnocast::Node node{"survivor"};
+  std::vector<std::uint64_t> seqs;
+  bool intact = true;
+  auto subscription = node.create_subscription<Message>(
+      topic, QoS{64}, [&](const agnocast::ipc_shared_ptr<const Message>& message) {
+        intact = intact && chatter::verify(*message);
+        seqs.push_back(message->seq);
+      });
+  agnocast::SingleThreadedExecutor executor;
+  executor.add_node(node);
+  auto pools_we_map = [] {
+    for (const auto& process : agnocast::list_processes()) {
+      if (process.pid == ::getpid()) return process.pools_mapped;
+    }
+    return ~0U;
+  };
+  auto pool_of = [](pid_t pid) -> std::uint64_t {
+    for (const auto& process : agnocast::list_processes()) {
+      if (process.pid == pid) return process.pool_addr;
+    }
+    return 0;
+  };
+  std::vector<std::uint64_t> pool_addresses;
+  for (std::uint64_t first : {0U, 100U}) {
+    Pipe published, finish;
+    const std::size_t expected = seqs.size() + 10;
+    const pid_t talker = fork_child([&] {
+      agnocast::Node talker_node{"talker"};
+      auto publisher = talker_node.create_publisher<Message>(topic, QoS{16});
+      for (std::uint64_t seq = first; seq < first + 10; ++seq) publish(*publisher, seq, 4096);
+      published.send();
+      return finish.receive() == 'x' ? 0 : 1;
+    });
+    ASSERT_EQ(published.receive(), 'x');
+    pool_addresses.push_back(pool_of(talker));
+    ASSERT_TRUE(spin_until(executor, [&] { return seqs.size() >= expected; }));
+    EXPECT_EQ(pools_we_map(), 1U);
+    finish.send();
+    EXPECT_TRUE(exited_ok(wait_child(talker)));
+    // Its window goes with it; we hold nothing, so its pool is freed.
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (pools_we_map() != 0 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(10ms);
+    }
+    EXPECT_EQ(pools_we_map(), 0U);
+  }
+  ASSERT_EQ(pool_addresses.size(), 2U);
+  EXPECT_NE(pool_addresses[0], 0U);
+  EXPECT_EQ(pool_addresses[1], pool_addresses[0]);  // the same slot, a new pool
+  ASSERT_EQ(seqs.size(), 20U);
+  for (std::uint64_t i = 0; i < 10; ++i) {
+    EXPECT_EQ(seqs[i], i);
+    EXPECT_EQ(seqs[10 + i], 100 + i);
+  }
+  EXPECT_TRUE(intact);
+}
+
 TEST(Counters, PublishedBytesCountThePayloadFilledIn) {
   const std::string topic = unique_topic("bandwidth");
   agnocast::Node node{"counter"};

@@ -110,7 +110,8 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
   if (plan.wants("iceoryx") && !iceoryx) {
     std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
   }
-  for (std::size_t round = 1; round <= plan.rounds; ++round) {
+  const bool latency_wanted = plan.wants("floor") || plan.wants("latency") || iceoryx;
+  for (std::size_t round = 1; round <= plan.rounds && latency_wanted; ++round) {
     std::cerr << "latency round " << round << " of " << plan.rounds << "...\n";
     if (plan.wants("floor")) {
       add("mqueue_floor", "1 B", bench::run_mqueue_floor(share(plan.floor_count)));

@@ -106,6 +106,21 @@ inline void spin_until_quiet(agnocast::Executor& executor,
   }
 }
 
+// What a subscription has received: sequence numbers in arrival order, and
+// whether every payload verified.
+struct Received {
+  std::vector<std::uint64_t> seqs;
+  bool intact = true;
+
+  // A subscription callback that records into *this (which must outlive it).
+  auto recorder() {
+    return [this](const agnocast::ipc_shared_ptr<const Message>& message) {
+      intact = intact && chatter::verify(*message);
+      seqs.push_back(message->seq);
+    };
+  }
+};
+
 inline void publish(agnocast::Publisher<Message>& publisher, std::uint64_t seq,
                     std::size_t size = 64) {
   auto message = publisher.borrow_loaned_message();

@@ -71,23 +71,18 @@ TEST(Fanout, OnePublisherToThreeSubscriberProcesses) {
   for (int i = 0; i < 3; ++i) {
     listeners.push_back(fork_child([&] {
       agnocast::Node node{"listener"};
-      std::vector<std::uint64_t> seqs;
-      bool intact = true;
-      auto subscription = node.create_subscription<Message>(
-          topic, QoS{64}, [&](const agnocast::ipc_shared_ptr<const Message>& message) {
-            intact = intact && chatter::verify(*message);
-            seqs.push_back(message->seq);
-          });
+      Received received;
+      auto subscription = node.create_subscription<Message>(topic, QoS{64}, received.recorder());
       agnocast::SingleThreadedExecutor executor;
       executor.add_node(node);
       ready.send();
       if (!spin_until(
-              executor, [&] { return seqs.size() >= count; }, 60s))
+              executor, [&] { return received.seqs.size() >= count; }, 60s))
         return 2;
       for (std::uint64_t i = 0; i < count; ++i) {
-        if (seqs[i] != i) return 3;
+        if (received.seqs[i] != i) return 3;
       }
-      return intact ? 0 : 4;
+      return received.intact ? 0 : 4;
     }));
   }
   for (int i = 0; i < 3; ++i) ASSERT_EQ(ready.receive(), 'x');
@@ -447,13 +442,8 @@ TEST(Lifecycle, AHeldMessageKeepsItsSubscriberUntilReleased) {
 TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
   const std::string topic = unique_topic("slot_reuse");
   agnocast::Node node{"survivor"};
-  std::vector<std::uint64_t> seqs;
-  bool intact = true;
-  auto subscription = node.create_subscription<Message>(
-      topic, QoS{64}, [&](const agnocast::ipc_shared_ptr<const Message>& message) {
-        intact = intact && chatter::verify(*message);
-        seqs.push_back(message->seq);
-      });
+  Received received;
+  auto subscription = node.create_subscription<Message>(topic, QoS{64}, received.recorder());
   agnocast::SingleThreadedExecutor executor;
   executor.add_node(node);
   auto pools_we_map = [] {
@@ -471,7 +461,7 @@ TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
   std::vector<std::uint64_t> pool_addresses;
   for (std::uint64_t first : {0U, 100U}) {
     Pipe published, finish;
-    const std::size_t expected = seqs.size() + 10;
+    const std::size_t expected = received.seqs.size() + 10;
     const pid_t talker = fork_child([&] {
       agnocast::Node talker_node{"talker"};
       auto publisher = talker_node.create_publisher<Message>(topic, QoS{16});
@@ -481,7 +471,7 @@ TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
     });
     ASSERT_EQ(published.receive(), 'x');
     pool_addresses.push_back(pool_of(talker));
-    ASSERT_TRUE(spin_until(executor, [&] { return seqs.size() >= expected; }));
+    ASSERT_TRUE(spin_until(executor, [&] { return received.seqs.size() >= expected; }));
     EXPECT_EQ(pools_we_map(), 1U);
     finish.send();
     EXPECT_TRUE(exited_ok(wait_child(talker)));
@@ -495,12 +485,12 @@ TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
   ASSERT_EQ(pool_addresses.size(), 2U);
   EXPECT_NE(pool_addresses[0], 0U);
   EXPECT_EQ(pool_addresses[1], pool_addresses[0]);  // the same slot, a new pool
-  ASSERT_EQ(seqs.size(), 20U);
+  ASSERT_EQ(received.seqs.size(), 20U);
   for (std::uint64_t i = 0; i < 10; ++i) {
-    EXPECT_EQ(seqs[i], i);
-    EXPECT_EQ(seqs[10 + i], 100 + i);
+    EXPECT_EQ(received.seqs[i], i);
+    EXPECT_EQ(received.seqs[10 + i], 100 + i);
   }
-  EXPECT_TRUE(intact);
+  EXPECT_TRUE(received.intact);
 }
 
 TEST(Counters, PublishedBytesCountThePayloadFilledIn) {

@@ -4,6 +4,7 @@
  *
  * Locking overview (outermost first; see agnocast_ns.c):
  *   1. agnocast_ns_list_lock  (mutex)    the list of namespace states
+ *   1a. agnocast_ns.exit_read_lock (mutex) readers of exit records only
  *   2. agnocast_ns.lock       (mutex)    everything inside one namespace
  *   3. agnocast_proc_table_lock (spinlock) tgid -> process lookup; also taken
  *                                        from the process-exit tracepoint
@@ -23,8 +24,6 @@
 
 #include "agnocast.h"
 
-/* A namespace holds at most this many topics (-ENOSPC beyond). */
-#define AGNOCAST_TOPICS_PER_NS_MAX 4096
 /* Unreferenced id spaces kept so that topic_local_ids are not reused soon. */
 #define AGNOCAST_DORMANT_ID_SPACES_MAX 1024
 /* Spare messages and held records a process keeps of each kind. */
@@ -32,10 +31,17 @@
 
 struct ipc_namespace;
 struct pid;
+struct super_block;
+struct vfsmount;
+struct agnocast_exit_record_node;
+struct agnocast_policy_state;
 
 extern unsigned long agnocast_pool_size;
 extern unsigned int agnocast_pool_count;
 extern unsigned long agnocast_pool_base;
+extern unsigned int agnocast_max_endpoints_per_process;
+extern unsigned int agnocast_max_held_per_subscriber;
+extern unsigned int agnocast_max_topics_per_namespace;
 
 /* State of one IPC namespace. */
 struct agnocast_ns {
@@ -44,9 +50,15 @@ struct agnocast_ns {
 	 * under agnocast_ns_list_lock, and only then may the state be freed.
 	 */
 	atomic_t users;
-	struct ipc_namespace *ipc_ns;	/* key only: no reference is held */
-	unsigned int ipc_inum;		/* with ipc_ns, guards against reuse */
+	/*
+	 * The key: the superblock of the namespace's internal mqueue mount,
+	 * kept alive (and so never reused) by our reference on the mount.
+	 * Its s_fs_info is cleared when the namespace dies.
+	 */
+	struct vfsmount *mq_mnt;
+	struct super_block *mq_sb;
 
+	struct mutex exit_read_lock;	/* serialises readers of exit records */
 	struct mutex lock;
 	/* Everything below is protected by @lock. */
 	unsigned long *slot_map;	/* pool_count bits: slot in use */
@@ -61,7 +73,10 @@ struct agnocast_ns {
 	unsigned int nr_dormant_id_spaces;
 	struct list_head exit_records;	/* oldest first */
 	unsigned int nr_exit_records;	/* read without @lock by poll */
+	u64 exit_records_lost;		/* discarded, not yet reported; ditto */
+	u64 exit_records_seq;
 	wait_queue_head_t exit_wait;
+	struct agnocast_policy_state *policy;	/* NULL: everyone may */
 };
 
 /* A publisher's shared-memory pool, occupying one slot. */
@@ -85,6 +100,8 @@ struct agnocast_proc {
 	struct pid *pid;
 	struct agnocast_ns *ns;
 	struct work_struct teardown_work;
+	/* Queued when the process dies; NULL after. Protected by ns->lock. */
+	struct agnocast_exit_record_node *exit_record;
 
 	/* Protected by ns->lock. */
 	struct list_head ns_node;
@@ -160,6 +177,8 @@ struct agnocast_subscriber {
 	u32 nr_held;
 	u64 received;
 	u64 dropped;
+	/* Callback subscribers: queued when the process dies, NULL after. */
+	struct agnocast_exit_record_node *exit_record;
 	char node[AGNOCAST_NODE_NAME_MAX];
 };
 
@@ -191,6 +210,7 @@ struct agnocast_ctx {
 
 /* agnocast_ns.c */
 int agnocast_ns_key_matches(const struct agnocast_ns *ns);
+bool agnocast_ns_dead(const struct agnocast_ns *ns);
 struct agnocast_ns *agnocast_ns_get_current(void);
 void agnocast_ns_get(struct agnocast_ns *ns);
 void agnocast_ns_put(struct agnocast_ns *ns);
@@ -201,11 +221,25 @@ int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool r
 void agnocast_leave(struct agnocast_ctx *ctx);
 int agnocast_process_init(void);
 void agnocast_process_exit(void);
-void agnocast_exit_records_free(struct agnocast_ns *ns);
 int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_unregister_process(struct agnocast_ns *file_ns);
+
+/* agnocast_exit_records.c */
+struct agnocast_exit_record_node *agnocast_exit_record_alloc(void);
+void agnocast_exit_record_free(struct agnocast_exit_record_node *rec);
+void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
+				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic);
+void agnocast_exit_records_wake(struct agnocast_ns *ns);
+bool agnocast_exit_records_waiting(const struct agnocast_ns *ns);
+void agnocast_exit_records_free(struct agnocast_ns *ns);
 ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
 				   size_t count, bool nonblock);
+
+/* agnocast_policy.c */
+int agnocast_policy_check(const struct agnocast_ns *ns, const char *topic, bool publisher);
+void agnocast_policy_free(struct agnocast_policy_state *policy);
+int agnocast_set_policy(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg);
 
 /* agnocast_pool.c */
 struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
@@ -232,6 +266,7 @@ int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg);
 bool agnocast_topic_name_valid(const char *name);
 struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
 

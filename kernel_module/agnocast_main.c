@@ -29,6 +29,20 @@ unsigned long agnocast_pool_base = 0x40000000000UL;
 module_param_named(pool_base, agnocast_pool_base, ulong, 0444);
 MODULE_PARM_DESC(pool_base, "Address of slot 0 (page aligned, default 0x40000000000)");
 
+unsigned int agnocast_max_endpoints_per_process = 1024;
+module_param_named(max_endpoints_per_process, agnocast_max_endpoints_per_process, uint, 0444);
+MODULE_PARM_DESC(max_endpoints_per_process,
+		 "Publishers plus subscribers one process may have (default 1024)");
+
+unsigned int agnocast_max_held_per_subscriber = 4096;
+module_param_named(max_held_per_subscriber, agnocast_max_held_per_subscriber, uint, 0444);
+MODULE_PARM_DESC(max_held_per_subscriber,
+		 "Entries one subscriber may hold, received and not released (default 4096)");
+
+unsigned int agnocast_max_topics_per_namespace = 4096;
+module_param_named(max_topics_per_namespace, agnocast_max_topics_per_namespace, uint, 0444);
+MODULE_PARM_DESC(max_topics_per_namespace, "Topics one IPC namespace may have (default 4096)");
+
 /* Keeps bitmaps and slot tables of a namespace reasonably small. */
 #define AGNOCAST_POOL_COUNT_MAX 65536
 /* Lowest user address a pool may start at: far above any mmap_min_addr. */
@@ -46,6 +60,13 @@ static int agnocast_params_valid(void)
 	if (!agnocast_pool_count || agnocast_pool_count > AGNOCAST_POOL_COUNT_MAX) {
 		pr_err("agnocast: pool_count=%u must be within 1..%u\n",
 		       agnocast_pool_count, AGNOCAST_POOL_COUNT_MAX);
+		return -EINVAL;
+	}
+	if (!agnocast_max_endpoints_per_process || !agnocast_max_held_per_subscriber ||
+	    !agnocast_max_topics_per_namespace) {
+		pr_err("agnocast: max_endpoints_per_process=%u, max_held_per_subscriber=%u and max_topics_per_namespace=%u must be at least 1\n",
+		       agnocast_max_endpoints_per_process, agnocast_max_held_per_subscriber,
+		       agnocast_max_topics_per_namespace);
 		return -EINVAL;
 	}
 	if (!PAGE_ALIGNED(agnocast_pool_base) || agnocast_pool_base < AGNOCAST_POOL_BASE_MIN) {
@@ -110,6 +131,12 @@ static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long ar
 		return agnocast_topic_info(ns, uarg);
 	case AGNOCAST_IOC_LIST_PROCESSES:
 		return agnocast_list_processes(ns, uarg);
+	case AGNOCAST_IOC_SHED:
+		return agnocast_shed(ns, uarg);
+	case AGNOCAST_IOC_SET_POLICY:
+		return agnocast_set_policy(ns, uarg);
+	case AGNOCAST_IOC_GET_POLICY:
+		return agnocast_get_policy(ns, uarg);
 	default:
 		return -ENOTTY;
 	}
@@ -160,7 +187,8 @@ static struct miscdevice agnocast_misc = {
 	.minor = MISC_DYNAMIC_MINOR,
 	.name = "agnocast",
 	.fops = &agnocast_fops,
-	.mode = 0666,
+	/* Group access comes from the udev rule (group agnocast). */
+	.mode = 0660,
 };
 
 static int __init agnocast_init(void)

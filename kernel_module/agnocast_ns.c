@@ -4,9 +4,15 @@
  *
  * Topics, ids, pool slots and exit records belong to the IPC namespace of the
  * calling process, like POSIX message queues.  put_ipc_ns() is not exported,
- * so no reference on the namespace is taken: the state is keyed by the
- * namespace's address plus its inode number and freed as soon as it is idle
- * (no users, no processes, no topics, no exit records).
+ * so no reference on the namespace is taken.  The state is keyed instead by
+ * the superblock of the namespace's internal mqueue mount, on which it holds
+ * a mount reference: the superblock then outlives the namespace, so no later
+ * namespace can have the same key, and the kernel clears its s_fs_info when
+ * the namespace dies, which tells us the state is dead.  State is freed when
+ * it has no users and no processes and either is idle (no topics, no exit
+ * records) or belongs to a dead namespace, whose exit records nobody can
+ * read any more.  Dead states left behind by a last user from another
+ * namespace are collected at the next open.
  *
  * Locking order (outermost first):
  *   agnocast_ns_list_lock -> agnocast_ns.lock -> agnocast_proc_table_lock
@@ -18,45 +24,55 @@
  * until release, which cannot run during the ioctl) instead of taking one.
  */
 #include <linux/bitmap.h>
+#include <linux/fs.h>
 #include <linux/ipc_namespace.h>
+#include <linux/mount.h>
 #include <linux/nsproxy.h>
 #include <linux/sched.h>
 #include <linux/slab.h>
 
 #include "agnocast_internal.h"
 
+#ifndef CONFIG_POSIX_MQUEUE
+#error "agnocast needs POSIX message queues (CONFIG_POSIX_MQUEUE)"
+#endif
+
 static DEFINE_MUTEX(agnocast_ns_list_lock);
 static LIST_HEAD(agnocast_ns_list);
 
-static struct ipc_namespace *agnocast_current_ipc_ns(void)
+/* The caller's namespace is alive (its nsproxy holds it), and so its mount. */
+static struct vfsmount *agnocast_current_mq_mnt(void)
 {
-	return current->nsproxy->ipc_ns;
+	return current->nsproxy->ipc_ns->mq_mnt;
 }
 
 int agnocast_ns_key_matches(const struct agnocast_ns *ns)
 {
-	struct ipc_namespace *ipc_ns = agnocast_current_ipc_ns();
+	return ns->mq_sb == agnocast_current_mq_mnt()->mnt_sb;
+}
 
-	return ns->ipc_ns == ipc_ns && ns->ipc_inum == ipc_ns->ns.inum;
+bool agnocast_ns_dead(const struct agnocast_ns *ns)
+{
+	return !READ_ONCE(ns->mq_sb->s_fs_info);
 }
 
 static struct agnocast_ns *agnocast_ns_alloc(void)
 {
-	struct ipc_namespace *ipc_ns = agnocast_current_ipc_ns();
 	struct agnocast_ns *ns;
 
-	ns = kzalloc(sizeof(*ns), GFP_KERNEL);
+	ns = kzalloc(sizeof(*ns), GFP_KERNEL_ACCOUNT);
 	if (!ns)
 		return NULL;
-	ns->slot_map = bitmap_zalloc(agnocast_pool_count, GFP_KERNEL);
+	ns->slot_map = bitmap_zalloc(agnocast_pool_count, GFP_KERNEL_ACCOUNT);
 	if (!ns->slot_map)
 		goto err_free_ns;
-	ns->slots = kvcalloc(agnocast_pool_count, sizeof(*ns->slots), GFP_KERNEL);
+	ns->slots = kvcalloc(agnocast_pool_count, sizeof(*ns->slots), GFP_KERNEL_ACCOUNT);
 	if (!ns->slots)
 		goto err_free_map;
 
-	ns->ipc_ns = ipc_ns;
-	ns->ipc_inum = ipc_ns->ns.inum;
+	ns->mq_mnt = mntget(agnocast_current_mq_mnt());
+	ns->mq_sb = ns->mq_mnt->mnt_sb;
+	mutex_init(&ns->exit_read_lock);
 	mutex_init(&ns->lock);
 	INIT_LIST_HEAD(&ns->procs);
 	hash_init(ns->topics);
@@ -74,29 +90,59 @@ err_free_ns:
 	return NULL;
 }
 
+/* Runs without agnocast_ns_list_lock: dropping the mount may free a superblock. */
 static void agnocast_ns_free(struct agnocast_ns *ns)
 {
 	agnocast_exit_records_free(ns);
 	agnocast_id_spaces_free(ns);
+	agnocast_policy_free(ns->policy);
 	idr_destroy(&ns->topic_handles);
 	kvfree(ns->slots);
 	bitmap_free(ns->slot_map);
 	mutex_destroy(&ns->lock);
+	mutex_destroy(&ns->exit_read_lock);
+	mntput(ns->mq_mnt);
 	kfree(ns);
 }
 
-static bool agnocast_ns_idle(const struct agnocast_ns *ns)
+static void agnocast_ns_free_list(struct list_head *list)
 {
-	return !atomic_read(&ns->users) && !ns->nr_procs && !ns->nr_topics &&
-	       !ns->nr_exit_records;
+	struct agnocast_ns *ns, *tmp;
+
+	list_for_each_entry_safe(ns, tmp, list, list_node)
+		agnocast_ns_free(ns);
+}
+
+/* Nobody can use the state again: free it. */
+static bool agnocast_ns_finished(const struct agnocast_ns *ns)
+{
+	if (atomic_read(&ns->users) || ns->nr_procs)
+		return false;
+	if (agnocast_ns_dead(ns))
+		return true;
+	return !ns->nr_topics && !agnocast_exit_records_waiting(ns);
+}
+
+/* Moves finished states to @dead, to be freed after the list lock is dropped. */
+static void agnocast_ns_collect(struct list_head *dead)
+{
+	struct agnocast_ns *ns, *tmp;
+
+	lockdep_assert_held(&agnocast_ns_list_lock);
+	list_for_each_entry_safe(ns, tmp, &agnocast_ns_list, list_node) {
+		if (agnocast_ns_finished(ns))
+			list_move(&ns->list_node, dead);
+	}
 }
 
 /* Returns the caller's namespace state with a user reference, or NULL. */
 struct agnocast_ns *agnocast_ns_get_current(void)
 {
 	struct agnocast_ns *ns;
+	LIST_HEAD(dead);
 
 	mutex_lock(&agnocast_ns_list_lock);
+	agnocast_ns_collect(&dead);
 	list_for_each_entry(ns, &agnocast_ns_list, list_node) {
 		if (agnocast_ns_key_matches(ns))
 			goto found;
@@ -109,6 +155,7 @@ found:
 	atomic_inc(&ns->users);
 out_unlock:
 	mutex_unlock(&agnocast_ns_list_lock);
+	agnocast_ns_free_list(&dead);
 	return ns;
 }
 
@@ -122,25 +169,28 @@ void agnocast_ns_get(struct agnocast_ns *ns)
 
 void agnocast_ns_put(struct agnocast_ns *ns)
 {
+	bool finished;
+
 	if (!atomic_dec_and_mutex_lock(&ns->users, &agnocast_ns_list_lock))
 		return;
-	if (agnocast_ns_idle(ns)) {
+	finished = agnocast_ns_finished(ns);
+	if (finished)
 		list_del(&ns->list_node);
-		agnocast_ns_free(ns);
-	}
 	mutex_unlock(&agnocast_ns_list_lock);
+	if (finished)
+		agnocast_ns_free(ns);
 }
 
 /* Module exit: every file is closed and no process is registered. */
 void agnocast_ns_exit(void)
 {
-	struct agnocast_ns *ns, *tmp;
+	struct agnocast_ns *ns;
+	LIST_HEAD(all);
 
 	mutex_lock(&agnocast_ns_list_lock);
-	list_for_each_entry_safe(ns, tmp, &agnocast_ns_list, list_node) {
+	list_for_each_entry(ns, &agnocast_ns_list, list_node)
 		WARN_ON_ONCE(atomic_read(&ns->users) || ns->nr_procs);
-		list_del(&ns->list_node);
-		agnocast_ns_free(ns);
-	}
+	list_splice_init(&agnocast_ns_list, &all);
 	mutex_unlock(&agnocast_ns_list_lock);
+	agnocast_ns_free_list(&all);
 }

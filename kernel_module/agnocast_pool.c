@@ -13,18 +13,23 @@
  * subscriber is handed the slot's next pool before it reads an entry there,
  * and replaces its stale view.
  *
- * The owner attaches a tmpfs file; the kernel keeps only a read-only
- * reopening of it, so whoever receives it can never map the pool writable.
+ * The owner attaches a sealed memfd: the seals (AGNOCAST_POOL_SEALS) leave
+ * the owner's existing writable mapping as the only way to write the pool,
+ * whoever opens the file and however (a reopening through /proc/<pid>/fd
+ * included).  The kernel keeps only a read-only reopening of it, so whoever
+ * receives it can never map the pool writable.
  *
  * All state here is protected by the namespace lock (agnocast_ns.lock).
  */
 #include <linux/bitmap.h>
+#include <linux/fcntl.h>
 #include <linux/file.h>
 #include <linux/fs.h>
 #include <linux/magic.h>
 #include <linux/pid.h>
 #include <linux/pid_namespace.h>
 #include <linux/sched.h>
+#include <linux/shmem_fs.h>
 #include <linux/slab.h>
 
 #include "agnocast_internal.h"
@@ -52,6 +57,20 @@ struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
 	return pool;
 }
 
+static_assert(AGNOCAST_POOL_SEALS ==
+	      (F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_FUTURE_WRITE | F_SEAL_SEAL));
+
+/* Seals that make a pool unwritable but through existing writable mappings. */
+static bool agnocast_pool_sealed(struct inode *inode)
+{
+	/* F_SEAL_WRITE (no writable mapping at all) is stronger than FUTURE_WRITE. */
+	unsigned int seals = READ_ONCE(SHMEM_I(inode)->seals);
+
+	if (seals & F_SEAL_WRITE)
+		seals |= F_SEAL_FUTURE_WRITE;
+	return (seals & AGNOCAST_POOL_SEALS) == AGNOCAST_POOL_SEALS;
+}
+
 int agnocast_pool_attach(struct agnocast_mempool *pool, int fd)
 {
 	struct file *file, *ro;
@@ -65,8 +84,11 @@ int agnocast_pool_attach(struct agnocast_mempool *pool, int fd)
 		return -EBADF;
 	inode = file_inode(file);
 	/* Never hand out a read descriptor to what the owner cannot read. */
-	if (!(file->f_mode & FMODE_READ) || !S_ISREG(inode->i_mode) || inode->i_sb->s_magic != TMPFS_MAGIC ||
-	    i_size_read(inode) < pool->size)
+	if (!IS_ENABLED(CONFIG_SHMEM) || !(file->f_mode & FMODE_READ) || !S_ISREG(inode->i_mode) ||
+	    inode->i_sb->s_magic != TMPFS_MAGIC || i_size_read(inode) < pool->size)
+		goto out_put;
+	ret = -EPERM;
+	if (!agnocast_pool_sealed(inode))
 		goto out_put;
 
 	ro = dentry_open(&file->f_path, O_RDONLY | O_LARGEFILE, current_cred());

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0
 /*
- * agnocast: registered processes, their teardown, and exit records.
+ * agnocast: registered processes and their teardown.
  *
  * A process is keyed by its thread-group id (init-namespace number) in
  * agnocast_proc_table.  Its death is detected with a probe on the
@@ -22,7 +22,6 @@
  * The table lock is a spinlock because the exit probe cannot sleep.
  */
 #include <linux/bitmap.h>
-#include <linux/capability.h>
 #include <linux/hashtable.h>
 #include <linux/ipc_namespace.h>
 #include <linux/module.h>
@@ -43,14 +42,6 @@ static DEFINE_HASHTABLE(agnocast_proc_table, 10);
 static struct workqueue_struct *agnocast_wq;
 static struct tracepoint *agnocast_exit_tp;
 
-struct agnocast_exit_record_node {
-	struct list_head node;
-	u32 kind;
-	u32 subscriber_id;
-	struct pid *pid;
-	char topic[AGNOCAST_TOPIC_NAME_MAX];
-};
-
 /* Finds the live registration of @tgid.  Dying ones are being torn down. */
 static struct agnocast_proc *agnocast_proc_lookup(pid_t tgid)
 {
@@ -64,64 +55,22 @@ static struct agnocast_proc *agnocast_proc_lookup(pid_t tgid)
 	return NULL;
 }
 
-static void agnocast_exit_record_push(struct agnocast_ns *ns, u32 kind,
-				      struct pid *pid, u32 subscriber_id,
-				      const char *topic)
-{
-	struct agnocast_exit_record_node *rec;
-
-	lockdep_assert_held(&ns->lock);
-	rec = kzalloc(sizeof(*rec), GFP_KERNEL);
-	if (!rec) {
-		pr_warn_ratelimited("agnocast: exit record of pid %d lost: out of memory\n",
-				    pid_nr(pid));
-		return;
-	}
-	rec->kind = kind;
-	rec->subscriber_id = subscriber_id;
-	rec->pid = get_pid(pid);
-	if (topic)
-		strscpy(rec->topic, topic, sizeof(rec->topic));
-
-	if (ns->nr_exit_records >= AGNOCAST_EXIT_RECORDS_MAX) {
-		struct agnocast_exit_record_node *oldest;
-
-		oldest = list_first_entry(&ns->exit_records,
-					  struct agnocast_exit_record_node, node);
-		list_del(&oldest->node);
-		put_pid(oldest->pid);
-		kfree(oldest);
-		ns->nr_exit_records--;
-	}
-	list_add_tail(&rec->node, &ns->exit_records);
-	WRITE_ONCE(ns->nr_exit_records, ns->nr_exit_records + 1);
-}
-
-void agnocast_exit_records_free(struct agnocast_ns *ns)
-{
-	struct agnocast_exit_record_node *rec, *tmp;
-
-	list_for_each_entry_safe(rec, tmp, &ns->exit_records, node) {
-		put_pid(rec->pid);
-		kfree(rec);
-	}
-	INIT_LIST_HEAD(&ns->exit_records);
-	ns->nr_exit_records = 0;
-}
-
 static void agnocast_queue_exit_records(struct agnocast_proc *proc)
 {
 	struct agnocast_ns *ns = proc->ns;
 	struct agnocast_subscriber *sub;
 
 	list_for_each_entry(sub, &proc->subscribers, proc_node) {
-		if (sub->flags & AGNOCAST_POLLING)
+		if (!sub->exit_record)
 			continue;
-		agnocast_exit_record_push(ns, AGNOCAST_EXIT_QUEUE, proc->pid, sub->id,
-					  sub->topic->name);
+		agnocast_exit_record_queue(ns, sub->exit_record, AGNOCAST_EXIT_QUEUE, proc->pid,
+					   sub->id, sub->topic->name);
+		sub->exit_record = NULL;
 	}
-	agnocast_exit_record_push(ns, AGNOCAST_EXIT_PROCESS, proc->pid, 0, NULL);
-	wake_up_interruptible(&ns->exit_wait);
+	agnocast_exit_record_queue(ns, proc->exit_record, AGNOCAST_EXIT_PROCESS, proc->pid, 0,
+				   NULL);
+	proc->exit_record = NULL;
+	agnocast_exit_records_wake(ns);
 }
 
 /*
@@ -148,6 +97,7 @@ static void agnocast_proc_teardown(struct agnocast_proc *proc, bool record)
 	list_del(&proc->ns_node);
 	ns->nr_procs--;
 	put_pid(proc->pid);
+	agnocast_exit_record_free(proc->exit_record);
 	bitmap_free(proc->given);
 	kfree(proc);
 	module_put(THIS_MODULE);
@@ -280,6 +230,9 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 	proc->given = bitmap_zalloc(agnocast_pool_count, GFP_KERNEL_ACCOUNT);
 	if (!proc->given)
 		goto err_free_proc;
+	proc->exit_record = agnocast_exit_record_alloc();
+	if (!proc->exit_record)
+		goto err_free_given;
 	proc->pool = agnocast_pool_reserve(ns, proc);
 	if (IS_ERR(proc->pool)) {
 		*err = PTR_ERR(proc->pool);
@@ -312,6 +265,7 @@ err_free_pool:
 	proc->pool->owner = NULL;
 	agnocast_pool_maybe_free(ns, proc->pool);
 err_free_given:
+	agnocast_exit_record_free(proc->exit_record);
 	bitmap_free(proc->given);
 err_free_proc:
 	kfree(proc);
@@ -367,61 +321,4 @@ int agnocast_unregister_process(struct agnocast_ns *file_ns)
 	agnocast_proc_teardown(ctx.proc, false);
 	agnocast_leave(&ctx);
 	return 0;
-}
-
-static bool agnocast_may_read_exit_records(struct agnocast_ns *ns)
-{
-	if (!agnocast_ns_key_matches(ns))
-		return false;
-	return ns_capable(current->nsproxy->ipc_ns->user_ns, CAP_SYS_ADMIN);
-}
-
-ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
-				   size_t count, bool nonblock)
-{
-	struct pid_namespace *pid_ns = task_active_pid_ns(current);
-	struct agnocast_exit_record_node *rec, *tmp;
-	struct agnocast_exit_record out;
-	ssize_t done = 0;
-	int ret;
-
-	if (!agnocast_may_read_exit_records(ns))
-		return -EPERM;
-	if (count < sizeof(out))
-		return -EINVAL;
-
-	for (;;) {
-		mutex_lock(&ns->lock);
-		if (ns->nr_exit_records)
-			break;
-		mutex_unlock(&ns->lock);
-		if (nonblock)
-			return -EAGAIN;
-		ret = wait_event_interruptible(ns->exit_wait,
-					       READ_ONCE(ns->nr_exit_records));
-		if (ret)
-			return ret;
-	}
-
-	list_for_each_entry_safe(rec, tmp, &ns->exit_records, node) {
-		if (count - (size_t)done < sizeof(out))
-			break;
-		memset(&out, 0, sizeof(out));
-		out.kind = rec->kind;
-		out.pid = pid_nr_ns(rec->pid, pid_ns);
-		out.subscriber_id = rec->subscriber_id;
-		memcpy(out.topic, rec->topic, sizeof(out.topic));
-		if (copy_to_user(buf + done, &out, sizeof(out))) {
-			if (!done)
-				done = -EFAULT;
-			break;
-		}
-		done += sizeof(out);
-		list_del(&rec->node);
-		put_pid(rec->pid);
-		kfree(rec);
-		WRITE_ONCE(ns->nr_exit_records, ns->nr_exit_records - 1);
-	}
-	mutex_unlock(&ns->lock);
-	return done;
 }

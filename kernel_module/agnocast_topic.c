@@ -154,8 +154,8 @@ static struct agnocast_topic *agnocast_topic_get(struct agnocast_ns *ns, const c
 	topic = agnocast_topic_find(ns, name);
 	if (topic)
 		return topic;
-	if (ns->nr_topics >= AGNOCAST_TOPICS_PER_NS_MAX)
-		return ERR_PTR(-ENOSPC);
+	if (ns->nr_topics >= agnocast_max_topics_per_namespace)
+		return ERR_PTR(-ENFILE);
 
 	topic = kzalloc(sizeof(*topic), GFP_KERNEL_ACCOUNT);
 	if (!topic)
@@ -163,7 +163,7 @@ static struct agnocast_topic *agnocast_topic_get(struct agnocast_ns *ns, const c
 	topic->ids = agnocast_id_space_get(ns, name);
 	if (!topic->ids)
 		goto err_free_topic;
-	handle = idr_alloc_cyclic(&ns->topic_handles, topic, 1, 0, GFP_KERNEL);
+	handle = idr_alloc_cyclic(&ns->topic_handles, topic, 1, 0, GFP_KERNEL_ACCOUNT);
 	if (handle < 0)
 		goto err_put_ids;
 
@@ -321,6 +321,7 @@ static void agnocast_subscriber_destroy(struct agnocast_subscriber *sub)
 	if (!(sub->flags & AGNOCAST_POLLING))
 		sub->topic->nr_callback_subscribers--;
 	sub->proc->nr_subscribers--;
+	agnocast_exit_record_free(sub->exit_record);
 	kvfree(sub->unreceived);
 	kfree(sub);
 }
@@ -441,6 +442,13 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		goto out_free_arg;
+	ret = agnocast_policy_check(ctx.ns, arg->topic, publisher);
+	if (ret)
+		goto out_leave;
+	ret = -EMFILE;
+	if (ctx.proc->nr_publishers + ctx.proc->nr_subscribers >=
+	    agnocast_max_endpoints_per_process)
+		goto out_leave;
 	topic = agnocast_topic_get(ctx.ns, arg->topic);
 	if (IS_ERR(topic)) {
 		ret = PTR_ERR(topic);
@@ -466,6 +474,11 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 						 GFP_KERNEL_ACCOUNT);
 		if (!sub->unreceived)
 			goto out_free_sub;
+		if (!(arg->flags & AGNOCAST_POLLING)) {
+			sub->exit_record = agnocast_exit_record_alloc();
+			if (!sub->exit_record)
+				goto out_free_sub;
+		}
 	}
 
 	/* Report before committing: a bad buffer must not leave an endpoint. */
@@ -508,8 +521,10 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 	goto out_leave;
 
 out_free_sub:
-	if (sub)
+	if (sub) {
+		agnocast_exit_record_free(sub->exit_record);
 		kvfree(sub->unreceived);
+	}
 	kfree(sub);
 	kfree(pub);
 out_put_topic:
@@ -832,6 +847,13 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 		goto out_leave;
 
 	n = min(arg.entry_capacity, sub->nr_unreceived);
+	ret = -EDQUOT;
+	if (sub->nr_held >= agnocast_max_held_per_subscriber) {
+		if (n)
+			goto out_leave;
+	} else {
+		n = min(n, agnocast_max_held_per_subscriber - sub->nr_held);
+	}
 	ret = -ENOMEM;
 	if (n > AGNOCAST_RECEIVE_SMALL) {
 		entries = kvmalloc_array(n, sizeof(*entries), GFP_KERNEL);
@@ -923,6 +945,9 @@ int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 	arg.entry_count = 0;
 	arg.pool_count = 0;
 	if (sub->nr_unreceived) {
+		ret = -EDQUOT;
+		if (sub->nr_held >= agnocast_max_held_per_subscriber)
+			goto out_leave;
 		msg = agnocast_sub_unreceived(sub, sub->nr_unreceived - 1);
 		ret = agnocast_held_alloc_list(ctx.proc, &spare, 1);
 		if (ret)
@@ -992,4 +1017,51 @@ int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
 out_leave:
 	agnocast_leave(&ctx);
 	return ret;
+}
+
+/*
+ * Takes from @sub's unreceived entries those of @pool that have left their
+ * publisher's window; keeps the order of the rest.
+ */
+static u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool)
+{
+	u32 i, kept = 0, shed = 0, n = sub->nr_unreceived;
+
+	for (i = 0; i < n; i++) {
+		struct agnocast_msg *msg = agnocast_sub_unreceived(sub, i);
+
+		if (msg->pool == pool && !msg->publisher) {
+			agnocast_msg_unref(msg);
+			shed++;
+			continue;
+		}
+		/* kept <= i: this slot was read already. */
+		sub->unreceived[(sub->head + kept) % sub->depth] = msg;
+		kept++;
+	}
+	sub->nr_unreceived = kept;
+	sub->dropped += shed;
+	return shed;
+}
+
+int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_subscriber *sub;
+	struct agnocast_publisher *pub;
+	struct agnocast_shed arg = {};
+	struct agnocast_ctx ctx;
+	int ret;
+
+	ret = agnocast_enter(&ctx, file_ns, true);
+	if (ret)
+		return ret;
+	list_for_each_entry(pub, &ctx.proc->publishers, proc_node) {
+		list_for_each_entry(sub, &pub->topic->subscribers, topic_node)
+			arg.shed += agnocast_sub_shed(sub, ctx.proc->pool);
+	}
+	arg.reclaimable = ctx.proc->nr_reclaim;
+	agnocast_leave(&ctx);
+	if (copy_to_user(uarg, &arg, sizeof(arg)))
+		return -EFAULT;
+	return 0;
 }

@@ -28,6 +28,8 @@ std::vector<DeadProcess> DeadProcessCollector::add(
     const std::vector<agnocast::ExitRecord>& records) {
   std::vector<DeadProcess> dead;
   for (const auto& record : records) {
+    if (record.kind == agnocast::ExitRecord::Kind::lost)
+      continue;  // the periodic sweep finds those
     if (record.kind == agnocast::ExitRecord::Kind::queue) {
       pending_queues_[record.pid].push_back(record.queue());
       continue;

@@ -3,6 +3,7 @@
 #include <agnocast.h>
 #include <fcntl.h>
 #include <sys/ioctl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <string_view>
 #include <utility>
 
+#include "agnocast/access_policy.hpp"
 #include "agnocast/errors.hpp"
 
 namespace agnocast {
@@ -19,6 +21,8 @@ namespace agnocast {
 ModuleNotLoaded::ModuleNotLoaded()
     : Error("agnocast kernel module is not loaded (" AGNOCAST_DEVICE_PATH
             " missing): run `systemctl start agnocastd`") {}
+
+AccessDenied::AccessDenied(const std::string& message) : DeviceError(EACCES, message) {}
 
 }  // namespace agnocast
 
@@ -50,6 +54,9 @@ std::string errno_advice(int err) {
       return "the module does not know this command; are the module and library versions equal?";
     case EFAULT:
       return "an address is outside the memory the module accepts";
+    case EDQUOT:
+      return "this subscriber holds max_held_per_subscriber messages (module parameter): "
+             "release some (drop their ipc_shared_ptr) or raise the parameter";
     default:
       return std::strerror(err);
   }
@@ -102,7 +109,15 @@ std::string add_endpoint_advice(int err, const EndpointRequest& request, std::st
   switch (err) {
     case ENOSPC:
       return "topic " + request.topic + " already has the maximum number of " + std::string(kind) +
-             "s, or the IPC namespace has too many topics";
+             "s";
+    case ENFILE:
+      return "the IPC namespace has max_topics_per_namespace topics (module parameter): remove "
+             "unused topics or raise the parameter (\"module_parameters\" in "
+             "/etc/agnocast/agnocastd.json)";
+    case EMFILE:
+      return "this process has max_endpoints_per_process publishers and subscribers (module "
+             "parameter): remove some or raise the parameter (\"module_parameters\" in "
+             "/etc/agnocast/agnocastd.json)";
     case EINVAL:
       return "the module refused topic '" + request.topic + "', node '" + request.node +
              "' or depth " + std::to_string(request.depth) + " (1.." + std::to_string(depth_max) +
@@ -112,7 +127,81 @@ std::string add_endpoint_advice(int err, const EndpointRequest& request, std::st
   }
 }
 
+[[noreturn]] void fail_add_endpoint(std::string_view command, int err,
+                                    const EndpointRequest& request, std::string_view kind) {
+  if (err == EACCES) {
+    throw AccessDenied(
+        "agnocast: " + std::string(command) + " failed: the topic access policy does not let " +
+        "this process (uid " + std::to_string(::geteuid()) + ") " +
+        (kind == "publisher" ? "publish" : "subscribe to") + " topic " + request.topic +
+        ": ask the administrator to allow it in the \"access\" rules of "
+        "/etc/agnocast/agnocastd.json (`agnocast-cli policy show` shows the policy)");
+  }
+  fail(command, err, add_endpoint_advice(err, request, kind));
+}
+
+std::uint32_t principal_kind(AccessPrincipal::Kind kind) {
+  switch (kind) {
+    case AccessPrincipal::Kind::user:
+      return AGNOCAST_PRINCIPAL_USER;
+    case AccessPrincipal::Kind::group:
+      return AGNOCAST_PRINCIPAL_GROUP;
+    case AccessPrincipal::Kind::anyone:
+      break;
+  }
+  return AGNOCAST_PRINCIPAL_ANYONE;
+}
+
+AccessPrincipal::Kind principal_kind(std::uint32_t kind) {
+  switch (kind) {
+    case AGNOCAST_PRINCIPAL_USER:
+      return AccessPrincipal::Kind::user;
+    case AGNOCAST_PRINCIPAL_GROUP:
+      return AccessPrincipal::Kind::group;
+    default:
+      return AccessPrincipal::Kind::anyone;
+  }
+}
+
+std::uint32_t match_kind(TopicPattern::Match match) {
+  switch (match) {
+    case TopicPattern::Match::children:
+      return AGNOCAST_MATCH_CHILDREN;
+    case TopicPattern::Match::descendants:
+      return AGNOCAST_MATCH_DESCENDANTS;
+    case TopicPattern::Match::exact:
+      break;
+  }
+  return AGNOCAST_MATCH_EXACT;
+}
+
+TopicPattern::Match match_kind(std::uint32_t match) {
+  switch (match) {
+    case AGNOCAST_MATCH_CHILDREN:
+      return TopicPattern::Match::children;
+    case AGNOCAST_MATCH_DESCENDANTS:
+      return TopicPattern::Match::descendants;
+    default:
+      return TopicPattern::Match::exact;
+  }
+}
+
 }  // namespace
+
+void seal_pool(int memfd) {
+  if (::fcntl(memfd, F_ADD_SEALS, AGNOCAST_POOL_SEALS) != 0) {
+    const int err = errno;
+    throw Error("agnocast: sealing the shared pool (F_ADD_SEALS) failed: " +
+                std::string(std::strerror(err)));
+  }
+  // Seals already forbid writing; the mode also refuses read-write reopening
+  // through /proc/<pid>/fd to everyone but root.
+  if (::fchmod(memfd, 0444) != 0) {
+    const int err = errno;
+    throw Error("agnocast: making the shared pool read-only (fchmod) failed: " +
+                std::string(std::strerror(err)));
+  }
+}
 
 Device Device::open(bool nonblocking) {
   const int extra = O_CLOEXEC | (nonblocking ? O_NONBLOCK : 0);
@@ -122,7 +211,9 @@ Device Device::open(bool nonblocking) {
     const int err = errno;
     if (err == ENOENT || err == ENXIO || err == ENODEV) throw ModuleNotLoaded();
     fail("open " AGNOCAST_DEVICE_PATH, err,
-         err == EACCES ? "permission denied; check the device's mode (agnocastd sets it)"
+         err == EACCES ? "permission denied: only root and members of group agnocast may use "
+                         "agnocast; join the group (`sudo usermod -aG agnocast $USER`, then log "
+                         "in again)"
                        : std::string_view{});
   }
   return Device(fd);
@@ -161,6 +252,10 @@ PoolSlot Device::register_process(int pool_fd) const {
              "(modprobe agnocast pool_count=N, or the agnocastd configuration)");
       case EBUSY:
         fail("REGISTER_PROCESS", err, "this process's pool is already attached");
+      case EPERM:
+        fail("REGISTER_PROCESS", err,
+             "the module refused the pool because it is not sealed against writes by others "
+             "(library and module versions differ?)");
       default:
         fail("REGISTER_PROCESS", err);
     }
@@ -177,7 +272,7 @@ void Device::unregister_process() const {
 EndpointId Device::add_publisher(const EndpointRequest& request) const {
   agnocast_add_endpoint argument = make_endpoint_request(request);
   if (int err = call(fd_, AGNOCAST_IOC_ADD_PUBLISHER, &argument)) {
-    fail("ADD_PUBLISHER", err, add_endpoint_advice(err, request, "publisher"));
+    fail_add_endpoint("ADD_PUBLISHER", err, request, "publisher");
   }
   return EndpointId{argument.topic_handle, argument.id};
 }
@@ -185,7 +280,7 @@ EndpointId Device::add_publisher(const EndpointRequest& request) const {
 EndpointId Device::add_subscriber(const EndpointRequest& request) const {
   agnocast_add_endpoint argument = make_endpoint_request(request);
   if (int err = call(fd_, AGNOCAST_IOC_ADD_SUBSCRIBER, &argument)) {
-    fail("ADD_SUBSCRIBER", err, add_endpoint_advice(err, request, "subscriber"));
+    fail_add_endpoint("ADD_SUBSCRIBER", err, request, "subscriber");
   }
   return EndpointId{argument.topic_handle, argument.id};
 }
@@ -280,6 +375,105 @@ void Device::release(EndpointId subscriber, std::uint64_t entry_id) const {
   argument.subscriber_id = subscriber.id;
   argument.entry_id = entry_id;
   if (int err = call(fd_, AGNOCAST_IOC_RELEASE, &argument)) fail("RELEASE", err);
+}
+
+std::uint32_t Device::shed() const {
+  agnocast_shed argument{};
+  if (int err = call(fd_, AGNOCAST_IOC_SHED, &argument)) fail("SHED", err);
+  return argument.shed;
+}
+
+std::optional<AccessPolicy> Device::get_policy() const {
+  std::vector<agnocast_policy_rule> rules;
+  std::vector<agnocast_principal> principals;
+  agnocast_policy argument{};
+  for (;;) {
+    argument = {};
+    argument.rules = reinterpret_cast<std::uintptr_t>(rules.data());
+    argument.rule_count = static_cast<std::uint32_t>(rules.size());
+    argument.principals = reinterpret_cast<std::uintptr_t>(principals.data());
+    argument.principal_count = static_cast<std::uint32_t>(principals.size());
+    const int err = call(fd_, AGNOCAST_IOC_GET_POLICY, &argument);
+    if (err == 0) break;
+    if (err != ENOSPC) fail("GET_POLICY", err);
+    // The policy changed size: fetch again with the totals just reported.
+    rules.resize(argument.rule_count);
+    principals.resize(argument.principal_count);
+  }
+  if (!(argument.flags & AGNOCAST_POLICY_PRESENT)) return std::nullopt;
+  AccessPolicy policy;
+  policy.default_allow = !(argument.flags & AGNOCAST_POLICY_DEFAULT_DENY);
+  const auto principal_range = [&](std::uint32_t first, std::uint32_t count) {
+    std::vector<AccessPrincipal> out;
+    for (std::uint32_t i = first; i < first + count && i < argument.principal_count; ++i) {
+      out.push_back({principal_kind(principals[i].kind), principals[i].id});
+    }
+    return out;
+  };
+  for (std::uint32_t i = 0; i < argument.rule_count; ++i) {
+    const agnocast_policy_rule& raw = rules[i];
+    AccessRule rule;
+    rule.topics = to_string(
+        TopicPattern{bounded_string(raw.prefix, sizeof raw.prefix), match_kind(raw.match)});
+    if (raw.flags & AGNOCAST_RULE_PUBLISH) {
+      rule.publish = principal_range(raw.first_principal, raw.publish_count);
+    }
+    if (raw.flags & AGNOCAST_RULE_SUBSCRIBE) {
+      rule.subscribe =
+          principal_range(raw.first_principal + raw.publish_count, raw.subscribe_count);
+    }
+    policy.rules.push_back(std::move(rule));
+  }
+  return policy;
+}
+
+void Device::set_policy(const std::optional<AccessPolicy>& policy) const {
+  agnocast_policy argument{};
+  std::vector<agnocast_policy_rule> rules;
+  std::vector<agnocast_principal> principals;
+  if (policy) {
+    if (policy->rules.size() > AGNOCAST_POLICY_RULES_MAX) {
+      throw std::invalid_argument("the access policy has " + std::to_string(policy->rules.size()) +
+                                  " rules: at most " + std::to_string(AGNOCAST_POLICY_RULES_MAX));
+    }
+    for (const AccessRule& rule : policy->rules) {
+      const TopicPattern pattern = parse_topic_pattern(rule.topics);
+      agnocast_policy_rule raw{};
+      copy_name(raw.prefix, sizeof raw.prefix, pattern.prefix, "access rule topics");
+      raw.match = match_kind(pattern.match);
+      raw.first_principal = static_cast<std::uint32_t>(principals.size());
+      const auto add = [&](const std::optional<std::vector<AccessPrincipal>>& list,
+                           std::uint32_t flag, std::uint32_t& count) {
+        if (!list) return;
+        raw.flags |= flag;
+        for (const AccessPrincipal& principal : *list) {
+          principals.push_back(
+              {principal_kind(principal.kind),
+               principal.kind == AccessPrincipal::Kind::anyone ? 0 : principal.id});
+        }
+        count = static_cast<std::uint32_t>(list->size());
+      };
+      add(rule.publish, AGNOCAST_RULE_PUBLISH, raw.publish_count);
+      add(rule.subscribe, AGNOCAST_RULE_SUBSCRIBE, raw.subscribe_count);
+      rules.push_back(raw);
+    }
+    if (principals.size() > AGNOCAST_POLICY_PRINCIPALS_MAX) {
+      throw std::invalid_argument("the access policy names " + std::to_string(principals.size()) +
+                                  " users and groups in all: at most " +
+                                  std::to_string(AGNOCAST_POLICY_PRINCIPALS_MAX));
+    }
+    argument.flags =
+        AGNOCAST_POLICY_PRESENT | (policy->default_allow ? 0U : AGNOCAST_POLICY_DEFAULT_DENY);
+    argument.rule_count = static_cast<std::uint32_t>(rules.size());
+    argument.rules = reinterpret_cast<std::uintptr_t>(rules.data());
+    argument.principal_count = static_cast<std::uint32_t>(principals.size());
+    argument.principals = reinterpret_cast<std::uintptr_t>(principals.data());
+  }
+  if (int err = call(fd_, AGNOCAST_IOC_SET_POLICY, &argument)) {
+    fail("SET_POLICY", err,
+         err == EPERM ? "setting the access policy needs CAP_SYS_ADMIN (agnocastd does it)"
+                      : std::string_view{});
+  }
 }
 
 std::vector<TopicSummary> Device::list_topics() const {
@@ -381,10 +575,23 @@ std::vector<ExitRecord> Device::read_exit_records() const {
     const std::size_t count = static_cast<std::size_t>(got) / sizeof raw[0];
     for (std::size_t i = 0; i < count; ++i) {
       ExitRecord record;
-      record.kind =
-          raw[i].kind == AGNOCAST_EXIT_QUEUE ? ExitRecord::Kind::queue : ExitRecord::Kind::process;
+      switch (raw[i].kind) {
+        case AGNOCAST_EXIT_QUEUE:
+          record.kind = ExitRecord::Kind::queue;
+          break;
+        case AGNOCAST_EXIT_LOST:
+          record.kind = ExitRecord::Kind::lost;
+          break;
+        default:
+          record.kind = ExitRecord::Kind::process;
+          break;
+      }
       record.pid = raw[i].pid;
-      record.subscriber_id = raw[i].subscriber_id;
+      if (record.kind == ExitRecord::Kind::lost) {
+        record.lost_count = raw[i].subscriber_id;
+      } else {
+        record.subscriber_id = raw[i].subscriber_id;
+      }
       record.topic = bounded_string(raw[i].topic, sizeof raw[i].topic);
       records.push_back(std::move(record));
     }

@@ -6,11 +6,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "agnocast/access_policy.hpp"
 #include "agnocast/inspect.hpp"
 #include "agnocast/supervise.hpp"
 #include "agnocast/version.hpp"
@@ -77,6 +79,10 @@ struct TakeResult {
   PoolGrant pool;
 };
 
+// Seals a pool memfd the way the module requires before it attaches it: after
+// this the mapping made before is the only way to write the pool.
+void seal_pool(int memfd);
+
 class Device {
  public:
   // Opens /dev/agnocast O_CLOEXEC; read-write when permitted, else read-only
@@ -116,6 +122,14 @@ class Device {
                         std::span<PoolGrant> pools) const;
   TakeResult take(EndpointId subscriber) const;
   void release(EndpointId subscriber, std::uint64_t entry_id) const;
+  // Drops entries of this process's pool kept only for slow subscribers beyond
+  // the publisher's depth; returns how many. Reclaim afterwards.
+  std::uint32_t shed() const;
+
+  // The IPC namespace's topic access policy; nullopt when none is in force.
+  std::optional<AccessPolicy> get_policy() const;
+  // Needs CAP_SYS_ADMIN; nullopt removes the policy.
+  void set_policy(const std::optional<AccessPolicy>& policy) const;
 
   std::vector<TopicSummary> list_topics() const;
   // Returns false when no topic of that name has an endpoint.

@@ -94,7 +94,7 @@ Runtime* Runtime::create() {
   int memfd = -1;
   bool mapped = false;
   try {
-    memfd = ::memfd_create("agnocast_pool", MFD_CLOEXEC);
+    memfd = ::memfd_create("agnocast_pool", MFD_CLOEXEC | MFD_ALLOW_SEALING);
     if (memfd < 0) throw_errno("memfd_create for the shared pool", errno);
     if (::ftruncate(memfd, static_cast<off_t>(slot.size)) != 0) {
       throw_errno("sizing the shared pool to " + std::to_string(slot.size) + " bytes", errno);
@@ -102,6 +102,7 @@ Runtime* Runtime::create() {
     map_at(slot.addr, slot.size, PROT_READ | PROT_WRITE, memfd, /*replace=*/false,
            "this process's pool");
     mapped = true;
+    seal_pool(memfd);
     device.register_process(memfd);
     ::close(std::exchange(memfd, -1));  // the mapping keeps the file alive
   } catch (...) {
@@ -139,20 +140,25 @@ void Runtime::forget_in_fork_child() noexcept {
   runtime->device_->close();
 }
 
+// On a full pool: first take back what nobody references any more, then
+// ask the kernel to drop entries that only slow subscribers still wait for
+// (beyond the publisher's depth), and take those back too.
 void* Runtime::allocate(std::size_t size, std::size_t align) {
   for (int attempt = 0;; ++attempt) {
     {
       std::lock_guard lock(pool_mutex_);
       if (void* ptr = pool_.allocate(size, align)) return ptr;
     }
-    if (attempt == 1 || !device_) break;
+    if (attempt == 2 || !device_) break;
+    if (attempt == 1) device_->shed();
     reclaim_all();
   }
   throw PoolExhausted(
       "agnocast: the shared pool of this process (" + std::to_string(pool_size_ >> 20) +
       " MiB) has no room for " + std::to_string(size) +
-      " bytes: raise the module parameter pool_size (modprobe agnocast pool_size=BYTES, or "
-      "\"pool_size\" in /etc/agnocast/agnocastd.json), or hold fewer messages");
+      " bytes: raise the module parameter pool_size (\"module_parameters\": {\"pool_size\": "
+      "BYTES} in /etc/agnocast/agnocastd.json, or modprobe agnocast pool_size=BYTES), or hold "
+      "fewer messages");
 }
 
 void Runtime::deallocate(void* ptr) noexcept {

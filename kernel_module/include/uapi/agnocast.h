@@ -35,7 +35,7 @@
 
 /* The module and the library must agree on major and minor. */
 #define AGNOCAST_VERSION_MAJOR 0
-#define AGNOCAST_VERSION_MINOR 1
+#define AGNOCAST_VERSION_MINOR 2
 #define AGNOCAST_VERSION_PATCH 0
 
 /* Including the terminating NUL. */
@@ -67,17 +67,26 @@ struct agnocast_version {
  * Registration is two-step.  First pool_fd = -1: the kernel reserves a slot
  * and reports pool_addr and pool_size, the same virtual range in every
  * process of the namespace, and pid, the caller's pid as it sees itself.
- * The caller then maps a memfd (tmpfs) of pool_size bytes writable at
- * pool_addr and calls again with pool_fd set to attach it.  The kernel keeps
- * its own read-only reopening of the file and hands that to subscribers, so
- * no subscriber can ever map the pool writable.  Repeating the first step
- * returns the same slot.
+ * The caller then maps a memfd of pool_size bytes writable at pool_addr,
+ * seals it with AGNOCAST_POOL_SEALS and calls again with pool_fd set to
+ * attach it.  The seals make the caller's existing mapping the only way to
+ * write the pool: every new writable mapping, write() and size change fails
+ * for every process, whoever opens the file.  The kernel keeps its own
+ * read-only reopening of the file and hands that to subscribers.  Repeating
+ * the first step returns the same slot.
  *
  *   -EBUSY   pool already attached
  *   -ENOSPC  every pool slot is in use (module parameter pool_count)
  *   -EBADF   pool_fd is not an open descriptor
- *   -EINVAL  pool_fd is not a tmpfs file, or smaller than pool_size
+ *   -EINVAL  pool_fd is not a readable memfd (shmem) file, or smaller than
+ *            pool_size
+ *   -EPERM   pool_fd lacks one of AGNOCAST_POOL_SEALS (F_SEAL_WRITE is
+ *            accepted in place of F_SEAL_FUTURE_WRITE)
  */
+#define AGNOCAST_POOL_SEALS \
+	(0x0002 /* F_SEAL_SHRINK */ | 0x0004 /* F_SEAL_GROW */ | \
+	 0x0010 /* F_SEAL_FUTURE_WRITE */ | 0x0001 /* F_SEAL_SEAL */)
+
 struct agnocast_register_process {
 	__s32 pool_fd;
 	__s32 pid;
@@ -106,8 +115,13 @@ struct agnocast_register_process {
  * window of publishers that are transient-local too.
  *
  *   -EINVAL  bad name, label, depth or flags (POLLING on a publisher)
- *   -ENOSPC  the topic has PUBLISHERS/SUBSCRIBERS_PER_TOPIC_MAX endpoints,
- *            or the namespace has too many topics
+ *   -ENOSPC  the topic has PUBLISHERS/SUBSCRIBERS_PER_TOPIC_MAX endpoints
+ *   -ENFILE  the namespace has max_topics_per_namespace topics (module
+ *            parameter) and this would be a new one
+ *   -EMFILE  the process has max_endpoints_per_process endpoints (module
+ *            parameter)
+ *   -EACCES  the namespace's access policy (SET_POLICY) refuses the caller
+ *            this kind of endpoint on this topic
  */
 struct agnocast_add_endpoint {
 	char topic[AGNOCAST_TOPIC_NAME_MAX];
@@ -204,6 +218,9 @@ struct agnocast_pool {
  *      not been given; remaining, how many unreceived entries are left.
  *
  *   -EINVAL  entry_capacity or pool_capacity is zero
+ *   -EDQUOT  unreceived entries wait but the subscriber already holds
+ *            max_held_per_subscriber entries (module parameter): RELEASE
+ *            some first
  */
 struct agnocast_receive {
 	__u32 topic_handle;
@@ -224,6 +241,8 @@ struct agnocast_receive {
  * out: the newest unreceived entry, held until RELEASE (entry_count 1), or
  *      nothing (entry_count 0).  Older unreceived entries are passed over.
  *      pool is filled (pool_count 1) when the caller has not been given it.
+ *
+ *   -EDQUOT  as for RECEIVE
  */
 struct agnocast_take {
 	__u32 topic_handle;
@@ -243,6 +262,93 @@ struct agnocast_release {
 	__u32 topic_handle;
 	__u32 subscriber_id;
 	__u64 entry_id;
+};
+
+/*
+ * AGNOCAST_IOC_SHED: the caller's pool needs memory.  Every entry of the
+ * caller's pool that has left its publisher's depth window and is kept only
+ * because subscribers have not received it yet is taken from those
+ * subscribers (counted in their dropped); entries a subscriber holds are
+ * never taken.  Entries no one references any more become reclaimable:
+ * out: shed, the number of entries taken from subscribers; reclaimable, the
+ * number now waiting for RECLAIM (this call's and earlier ones).
+ */
+struct agnocast_shed {
+	__u32 shed;
+	__u32 reclaimable;
+};
+
+/*
+ * Topic access policy of an IPC namespace, checked at ADD_PUBLISHER and
+ * ADD_SUBSCRIBER (-EACCES).  Without a policy everyone who can open the
+ * device read-write may create endpoints.
+ *
+ * A rule matches a topic by prefix and match kind: EXACT, the topic equals
+ * prefix; CHILDREN, the topic is prefix + "/" + one more level (pattern
+ * "prefix/ *" without the space); DESCENDANTS, the topic is prefix + "/" +
+ * any number of levels ("prefix/ **"; an empty prefix matches every topic).
+ * The first matching rule decides; a rule without AGNOCAST_RULE_PUBLISH
+ * (SUBSCRIBE) leaves that direction to the default.  A listed direction is
+ * allowed when one of its principals matches the caller's filesystem uid or
+ * any of its groups.  No rule matching: the default decides.
+ */
+#define AGNOCAST_POLICY_RULES_MAX 256
+#define AGNOCAST_POLICY_PRINCIPALS_MAX 4096
+
+#define AGNOCAST_MATCH_EXACT 0
+#define AGNOCAST_MATCH_CHILDREN 1
+#define AGNOCAST_MATCH_DESCENDANTS 2
+
+#define AGNOCAST_PRINCIPAL_ANYONE 0
+#define AGNOCAST_PRINCIPAL_USER 1
+#define AGNOCAST_PRINCIPAL_GROUP 2
+
+/* Rule flags: which directions the rule lists principals for. */
+#define AGNOCAST_RULE_PUBLISH (1U << 0)
+#define AGNOCAST_RULE_SUBSCRIBE (1U << 1)
+
+/* Policy flags. */
+#define AGNOCAST_POLICY_PRESENT (1U << 0)	/* a policy is in force */
+#define AGNOCAST_POLICY_DEFAULT_DENY (1U << 1)
+
+struct agnocast_principal {
+	__u32 kind;
+	__u32 id;	/* uid or gid in the caller's user namespace */
+};
+
+/* Principals of a rule: publish ones first, then subscribe ones. */
+struct agnocast_policy_rule {
+	char prefix[AGNOCAST_TOPIC_NAME_MAX];
+	__u32 match;
+	__u32 flags;
+	__u32 first_principal;	/* index into the policy's principals */
+	__u32 publish_count;
+	__u32 subscribe_count;
+	__u32 reserved;
+};
+
+/*
+ * AGNOCAST_IOC_SET_POLICY: replace the namespace's policy (flags without
+ * AGNOCAST_POLICY_PRESENT removes it).  Existing endpoints stay.  Needs
+ * CAP_SYS_ADMIN over the IPC namespace's user namespace.
+ *
+ *   -EPERM   the caller lacks that capability
+ *   -EINVAL  a count over its _MAX, a prefix that is not "" or a valid topic
+ *            name, an unknown match/kind/flag, principals out of range, or an
+ *            id that does not map into the caller's user namespace
+ *
+ * AGNOCAST_IOC_GET_POLICY: anyone.  in: capacities in rule_count and
+ * principal_count (arrays may be 0 with capacity 0).  out: the policy's
+ * flags and its total counts; the arrays are filled when they fit, else
+ * -ENOSPC (call again with the totals).
+ */
+struct agnocast_policy {
+	__u32 flags;
+	__u32 rule_count;
+	__u32 principal_count;
+	__u32 reserved;
+	__u64 rules;
+	__u64 principals;
 };
 
 /* Introspection: callable without registering. */
@@ -349,12 +455,17 @@ struct agnocast_list_processes {
 #define AGNOCAST_IOC_TOPIC_INFO _IOWR(AGNOCAST_IOC_MAGIC, 13, struct agnocast_topic_info)
 #define AGNOCAST_IOC_LIST_PROCESSES \
 	_IOWR(AGNOCAST_IOC_MAGIC, 14, struct agnocast_list_processes)
+#define AGNOCAST_IOC_SHED _IOR(AGNOCAST_IOC_MAGIC, 15, struct agnocast_shed)
+#define AGNOCAST_IOC_SET_POLICY _IOW(AGNOCAST_IOC_MAGIC, 16, struct agnocast_policy)
+#define AGNOCAST_IOC_GET_POLICY _IOWR(AGNOCAST_IOC_MAGIC, 17, struct agnocast_policy)
 
 /*
  * Exit records: read() on /dev/agnocast returns whole records, oldest first,
  * of the caller's namespace; poll() reports POLLIN while any wait.  Records
- * stay queued until read, so a restarted daemon misses none; past
- * AGNOCAST_EXIT_RECORDS_MAX the oldest are discarded.  Reading needs
+ * stay queued until read, so a restarted daemon misses none.  Past
+ * AGNOCAST_EXIT_RECORDS_MAX the oldest are discarded, and the next read
+ * starts with one AGNOCAST_EXIT_LOST record whose subscriber_id is how many
+ * were discarded: the reader must then look for leftovers itself.  Reading needs
  * CAP_SYS_ADMIN in the namespace's user namespace (-EPERM otherwise); a
  * buffer smaller than one record is -EINVAL; with none waiting, read blocks
  * or, with O_NONBLOCK, fails with -EAGAIN.
@@ -367,6 +478,7 @@ struct agnocast_list_processes {
 
 #define AGNOCAST_EXIT_PROCESS 1
 #define AGNOCAST_EXIT_QUEUE 2
+#define AGNOCAST_EXIT_LOST 3
 
 struct agnocast_exit_record {
 	__u32 kind;

@@ -35,6 +35,13 @@ class DeviceError : public Error {
   int code_;
 };
 
+// The topic access policy (agnocastd's "access" rules) refuses this endpoint;
+// what() names the topic and how to get access.
+class AccessDenied : public DeviceError {
+ public:
+  explicit AccessDenied(const std::string& message);
+};
+
 // A POSIX message queue could not be created or opened (often a system limit).
 class QueueError : public Error {
  public:

@@ -17,11 +17,13 @@ struct ExitRecord {
   enum class Kind {
     process,  // the process died; every record about it came before
     queue,    // a callback subscriber of the dead process owned this queue
+    lost,     // lost_count older records were discarded unread: look for leftovers
   };
   Kind kind = Kind::process;
   pid_t pid = 0;
   std::string topic;                // queue records only
   std::uint32_t subscriber_id = 0;  // queue records only
+  std::uint32_t lost_count = 0;     // lost records only
 
   // The notification queue a queue record names, e.g. "/chatter@1".
   std::string queue() const { return queue_name(topic, subscriber_id); }

@@ -214,6 +214,7 @@ bool agnocast_ns_dead(const struct agnocast_ns *ns);
 struct agnocast_ns *agnocast_ns_get_current(void);
 void agnocast_ns_get(struct agnocast_ns *ns);
 void agnocast_ns_put(struct agnocast_ns *ns);
+void agnocast_ns_init(void);
 void agnocast_ns_exit(void);
 
 /* agnocast_process.c */

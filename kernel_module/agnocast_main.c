@@ -201,9 +201,11 @@ static int __init agnocast_init(void)
 	ret = agnocast_process_init();
 	if (ret)
 		return ret;
+	agnocast_ns_init();
 	ret = misc_register(&agnocast_misc);
 	if (ret) {
 		pr_err("agnocast: cannot register /dev/agnocast: %d\n", ret);
+		agnocast_ns_exit();
 		agnocast_process_exit();
 		return ret;
 	}

@@ -24,6 +24,7 @@
  * until release, which cannot run during the ioctl) instead of taking one.
  */
 #include <linux/bitmap.h>
+#include <linux/debugfs.h>
 #include <linux/fs.h>
 #include <linux/ipc_namespace.h>
 #include <linux/mount.h>
@@ -39,6 +40,9 @@
 
 static DEFINE_MUTEX(agnocast_ns_list_lock);
 static LIST_HEAD(agnocast_ns_list);
+/* States on the list, shown in debugfs (agnocast/namespaces) for tests. */
+static u32 agnocast_nr_ns;
+static struct dentry *agnocast_debugfs;
 
 /* The caller's namespace is alive (its nsproxy holds it), and so its mount. */
 static struct vfsmount *agnocast_current_mq_mnt(void)
@@ -130,8 +134,10 @@ static void agnocast_ns_collect(struct list_head *dead)
 
 	lockdep_assert_held(&agnocast_ns_list_lock);
 	list_for_each_entry_safe(ns, tmp, &agnocast_ns_list, list_node) {
-		if (agnocast_ns_finished(ns))
+		if (agnocast_ns_finished(ns)) {
 			list_move(&ns->list_node, dead);
+			WRITE_ONCE(agnocast_nr_ns, agnocast_nr_ns - 1);
+		}
 	}
 }
 
@@ -151,6 +157,7 @@ struct agnocast_ns *agnocast_ns_get_current(void)
 	if (!ns)
 		goto out_unlock;
 	list_add(&ns->list_node, &agnocast_ns_list);
+	WRITE_ONCE(agnocast_nr_ns, agnocast_nr_ns + 1);
 found:
 	atomic_inc(&ns->users);
 out_unlock:
@@ -174,11 +181,19 @@ void agnocast_ns_put(struct agnocast_ns *ns)
 	if (!atomic_dec_and_mutex_lock(&ns->users, &agnocast_ns_list_lock))
 		return;
 	finished = agnocast_ns_finished(ns);
-	if (finished)
+	if (finished) {
 		list_del(&ns->list_node);
+		WRITE_ONCE(agnocast_nr_ns, agnocast_nr_ns - 1);
+	}
 	mutex_unlock(&agnocast_ns_list_lock);
 	if (finished)
 		agnocast_ns_free(ns);
+}
+
+void agnocast_ns_init(void)
+{
+	agnocast_debugfs = debugfs_create_dir("agnocast", NULL);
+	debugfs_create_u32("namespaces", 0400, agnocast_debugfs, &agnocast_nr_ns);
 }
 
 /* Module exit: every file is closed and no process is registered. */
@@ -187,10 +202,12 @@ void agnocast_ns_exit(void)
 	struct agnocast_ns *ns;
 	LIST_HEAD(all);
 
+	debugfs_remove_recursive(agnocast_debugfs);
 	mutex_lock(&agnocast_ns_list_lock);
 	list_for_each_entry(ns, &agnocast_ns_list, list_node)
 		WARN_ON_ONCE(atomic_read(&ns->users) || ns->nr_procs);
 	list_splice_init(&agnocast_ns_list, &all);
+	agnocast_nr_ns = 0;
 	mutex_unlock(&agnocast_ns_list_lock);
 	agnocast_ns_free_list(&all);
 }

@@ -3,6 +3,7 @@
 // hand-made stale queue /ghost@7. Every command's table and JSON are checked,
 // the exit codes 0/1/2, and, last, doctor failing once the module is removed.
 #include <fcntl.h>
+#include <grp.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -37,14 +38,19 @@ std::string slurp(const std::string& path) {
   return text.str();
 }
 
-// Runs agnocast-cli ARGS through sh, as root or, with `uid`, as that user.
+// Runs agnocast-cli ARGS through sh, as root or, with `uid`, as that user in
+// group agnocast (gid 990 in the VM), which may open the device.
 Outcome cli(const std::string& args, uid_t uid = 0) {
   const std::string out = "cli-" + std::to_string(uid) + ".out";
   const std::string err = "cli-" + std::to_string(uid) + ".err";
   const std::string command = "agnocast-cli " + args + " >" + out + " 2>" + err;
   const pid_t pid = ::fork();
   if (pid == 0) {
-    if (uid != 0 && (::setgid(uid) != 0 || ::setuid(uid) != 0)) ::_exit(126);
+    const gid_t agnocast_group = 990;
+    if (uid != 0 &&
+        (::setgroups(1, &agnocast_group) != 0 || ::setgid(uid) != 0 || ::setuid(uid) != 0)) {
+      ::_exit(126);
+    }
     ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }

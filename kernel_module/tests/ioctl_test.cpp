@@ -32,6 +32,10 @@ static_assert(sizeof(agnocast_topic_info) == 296);
 static_assert(sizeof(agnocast_process_info) == 32);
 static_assert(sizeof(agnocast_list_processes) == 16);
 static_assert(sizeof(agnocast_exit_record) == 272);
+static_assert(sizeof(agnocast_shed) == 8);
+static_assert(sizeof(agnocast_principal) == 8);
+static_assert(sizeof(agnocast_policy_rule) == 280);
+static_assert(sizeof(agnocast_policy) == 32);
 
 void* const kBadPtr = reinterpret_cast<void*>(8);
 
@@ -135,6 +139,37 @@ TEST_F(Device, RegisterErrors) {
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
   close(wronly);
   close(full);
+
+  // A pool without every seal of AGNOCAST_POOL_SEALS could be written by
+  // others: -EPERM, whichever seal is missing.
+  const unsigned int seals[] = {AGNOCAST_POOL_SEALS, F_SEAL_SHRINK, F_SEAL_GROW,
+                                F_SEAL_FUTURE_WRITE, F_SEAL_SEAL};
+  for (unsigned int missing : seals) {
+    int unsealed = memfd_create("unsealed", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+    ASSERT_EQ(ftruncate(unsealed, static_cast<off_t>(reg.size)), 0);
+    const unsigned int present = AGNOCAST_POOL_SEALS & ~missing;
+    if (present) {
+      ASSERT_EQ(fcntl(unsealed, F_ADD_SEALS, present), 0);
+    }
+    r.pool_fd = unsealed;
+    EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EPERM) << "seals " << present;
+    close(unsealed);
+  }
+  // F_SEAL_WRITE (no writable mapping at all) may stand for F_SEAL_FUTURE_WRITE.
+  int write_sealed = memfd_create("write-sealed", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+  ASSERT_EQ(ftruncate(write_sealed, static_cast<off_t>(reg.size)), 0);
+  ASSERT_EQ(
+      fcntl(write_sealed, F_ADD_SEALS, (AGNOCAST_POOL_SEALS & ~F_SEAL_FUTURE_WRITE) | F_SEAL_WRITE),
+      0);
+  Registration other;
+  EXPECT_EQ(in_child([&] {
+              if (other.reserve(open_device())) return 10;
+              agnocast_register_process attach = poisoned<agnocast_register_process>();
+              attach.pool_fd = write_sealed;
+              return ioc(other.dev, AGNOCAST_IOC_REGISTER_PROCESS, &attach) == 0 ? 0 : 11;
+            }),
+            0);
+  close(write_sealed);
 
   ASSERT_EQ(reg.attach(), 0);
   r = poisoned<agnocast_register_process>();

@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <sys/ioctl.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -67,9 +68,10 @@ struct Registration {
     return 0;
   }
 
-  int attach()
+  // Step two: map a memfd writable, seal it with @seals and attach it.
+  int attach(unsigned int seals = AGNOCAST_POOL_SEALS)
   {
-    memfd = memfd_create("agnocast-test", MFD_CLOEXEC);
+    memfd = memfd_create("agnocast-test", MFD_CLOEXEC | MFD_ALLOW_SEALING);
     if (memfd < 0 || ftruncate(memfd, static_cast<off_t>(size))) return -errno;
     map = mmap(reinterpret_cast<void *>(addr), size, PROT_READ | PROT_WRITE,
                MAP_SHARED | MAP_FIXED_NOREPLACE, memfd, 0);
@@ -77,6 +79,9 @@ struct Registration {
       map = nullptr;
       return -errno;
     }
+    if (seals && fcntl(memfd, F_ADD_SEALS, seals)) return -errno;
+    // As libagnocast does: nobody but root may reopen it read-write.
+    if (fchmod(memfd, 0444)) return -errno;
     agnocast_register_process reg = poisoned<agnocast_register_process>();
     reg.pool_fd = memfd;
     return ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg);

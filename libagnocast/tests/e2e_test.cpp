@@ -1,9 +1,11 @@
 // End-to-end tests of libagnocast against the real module (run in the VM).
 #include <dirent.h>
+#include <grp.h>
 #include <gtest/gtest.h>
 #include <sched.h>
 #include <sys/mount.h>
 
+#include <agnocast/access_policy.hpp>
 #include <agnocast/inspect.hpp>
 #include <algorithm>
 #include <map>
@@ -629,6 +631,107 @@ TEST(Exhaustion, MessagesHeldBySubscribersComeBackThroughReclaim) {
   message.reset();
   to_child.send('q');
   EXPECT_TRUE(exited_ok(wait_child(holder)));
+}
+
+// A subscriber that never receives keeps entries beyond the publisher's
+// depth only until the publisher needs the memory: 200 messages of 16 MiB
+// through a 1 GiB pool never fail to allocate, and the subscriber is told how
+// many it lost.
+TEST(Exhaustion, ASlowSubscriberCannotExhaustAPublishersPool) {
+  const std::string topic = unique_topic("slow");
+  Pipe to_child, to_parent;
+  const pid_t sleeper = fork_child([&] {
+    agnocast::Node node{"sleeper"};
+    auto subscription = node.create_subscription<Message>(
+        topic, QoS{1024}, [](const agnocast::ipc_shared_ptr<const Message>&) {});
+    to_parent.send('r');
+    return to_child.receive() == 'q' ? 0 : 2;  // never spins: receives nothing
+  });
+  ASSERT_EQ(to_parent.receive(), 'r');
+  agnocast::Node node{"producer"};
+  auto publisher = node.create_publisher<Message>(topic, QoS{1});
+  constexpr std::uint64_t count = 200;
+  for (std::uint64_t seq = 0; seq < count; ++seq) {
+    auto message = publisher->borrow_loaned_message();  // throws bad_alloc if it cannot
+    message->seq = seq;
+    message->payload.reserve(16 << 20);  // reserved, never touched: no RAM needed
+    publisher->publish(std::move(message));
+  }
+  const auto info = agnocast::topic_info(topic);
+  ASSERT_TRUE(info);
+  ASSERT_EQ(info->subscribers.size(), 1U);
+  const auto& slow = info->subscribers[0];
+  EXPECT_GT(slow.dropped, 0U);
+  EXPECT_EQ(slow.dropped + slow.unreceived, count);
+  to_child.send('q');
+  EXPECT_TRUE(exited_ok(wait_child(sleeper)));
+}
+
+constexpr gid_t agnocast_group = 990;  // the VM's group agnocast, which owns the device
+
+// Runs body as uid/gid 65534 with the given supplementary groups.
+int as_nobody(std::vector<gid_t> groups, const std::function<int()>& body) {
+  return wait_child(fork_child([&] {
+    if (::setgroups(groups.size(), groups.data()) != 0 || ::setgid(65534) != 0 ||
+        ::setuid(65534) != 0) {
+      return 100;
+    }
+    return body();
+  }));
+}
+
+TEST(Access, OutsideGroupAgnocastTheErrorSaysHowToJoin) {
+  const std::string topic = unique_topic("group");
+  const int status = as_nobody({}, [&] {
+    try {
+      agnocast::Node node{"outsider"};
+      auto publisher = node.create_publisher<Message>(topic, QoS{1});
+      return 2;
+    } catch (const agnocast::DeviceError& error) {
+      const std::string what = error.what();
+      return error.code() == EACCES && what.find("group agnocast") != std::string::npos &&
+                     what.find("usermod -aG agnocast") != std::string::npos
+                 ? 0
+                 : 3;
+    }
+  });
+  EXPECT_TRUE(exited_ok(status)) << status;
+  // A member may.
+  EXPECT_TRUE(exited_ok(as_nobody({agnocast_group}, [&] {
+    agnocast::Node node{"member"};
+    auto publisher = node.create_publisher<Message>(topic, QoS{1});
+    publish(*publisher, 1, 64);
+    return 0;
+  })));
+}
+
+TEST(Access, APolicyRefusalNamesTheTopicAndTheFix) {
+  const std::string allowed = unique_topic("open");
+  const std::string guarded = unique_topic("guarded");
+  agnocast::AccessPolicy policy;
+  policy.rules.push_back({guarded, std::vector<agnocast::AccessPrincipal>{}, std::nullopt});
+  agnocast::set_access_policy(policy);
+  EXPECT_EQ(agnocast::access_policy(), policy);
+  const int status = as_nobody({agnocast_group}, [&] {
+    agnocast::Node node{"someone"};
+    auto open_publisher = node.create_publisher<Message>(allowed, QoS{1});
+    auto subscriber = node.create_subscription<Message>(
+        guarded, QoS{1}, [](const agnocast::ipc_shared_ptr<const Message>&) {});
+    try {
+      auto publisher = node.create_publisher<Message>(guarded, QoS{1});
+      return 2;
+    } catch (const agnocast::AccessDenied& error) {
+      const std::string what = error.what();
+      if (what.find(guarded) == std::string::npos) return 3;
+      if (what.find("access") == std::string::npos) return 4;
+    }
+    // Nothing is left behind by the refusal.
+    const auto info = agnocast::topic_info(guarded);
+    return info && info->publishers.empty() ? 0 : 5;
+  });
+  agnocast::set_access_policy(std::nullopt);
+  EXPECT_TRUE(exited_ok(status)) << status;
+  EXPECT_EQ(agnocast::access_policy(), std::nullopt);
 }
 
 }  // namespace

@@ -169,7 +169,7 @@ static __poll_t agnocast_dev_poll(struct file *file, poll_table *wait)
 	struct agnocast_ns *ns = file->private_data;
 
 	poll_wait(file, &ns->exit_wait, wait);
-	return READ_ONCE(ns->nr_exit_records) ? EPOLLIN | EPOLLRDNORM : 0;
+	return agnocast_exit_records_waiting(ns) ? EPOLLIN | EPOLLRDNORM : 0;
 }
 
 static const struct file_operations agnocast_fops = {

@@ -46,6 +46,8 @@ class Device : public ::testing::Test {
     ASSERT_GE(dev, 0) << strerror(errno);
   }
   void TearDown() override {
+    agnocast_policy none{};  // a failed policy test must not hold back the others
+    ioc(dev, AGNOCAST_IOC_SET_POLICY, &none);
     reg.drop();
     close(dev);
   }
@@ -315,12 +317,47 @@ TEST_F(Device, AddEndpointRejectsBadInput) {
 TEST_F(Device, TooManyEndpointsIsEnospc) {
   registered();
   Endpoint ep;
+  // This process reaches max_endpoints_per_process (1024) with the topic's
+  // maximum subscribers; other processes then meet the topic's limit.
   for (int i = 0; i < AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX; i++)
     ASSERT_EQ(add_subscriber(dev, "/crowd", 1, &ep), 0) << i;
-  EXPECT_EQ(add_subscriber(dev, "/crowd", 1, &ep), -ENOSPC);
-  for (int i = 0; i < AGNOCAST_PUBLISHERS_PER_TOPIC_MAX; i++)
-    ASSERT_EQ(add_publisher(dev, "/crowd", 1, &ep), 0) << i;
-  EXPECT_EQ(add_publisher(dev, "/crowd", 1, &ep), -ENOSPC);
+  EXPECT_EQ(add_publisher(dev, "/elsewhere", 1, &ep), -EMFILE);
+  EXPECT_EQ(in_child([] {
+              Registration r;
+              Endpoint e;
+              int d = open_device();
+              if (r.reserve(d)) return 10;
+              return add_subscriber(d, "/crowd", 1, &e) == -ENOSPC ? 0 : 11;
+            }),
+            0);
+  // A second process fills the topic's publishers while a third tries.
+  int ready[2];
+  ASSERT_EQ(pipe(ready), 0);
+  pid_t holder = fork();
+  if (holder == 0) {
+    Registration r;
+    Endpoint e;
+    int d = open_device();
+    if (r.reserve(d)) _exit(10);
+    for (int i = 0; i < AGNOCAST_PUBLISHERS_PER_TOPIC_MAX; i++)
+      if (add_publisher(d, "/crowd", 1, &e)) _exit(11);
+    (void)!write(ready[1], "r", 1);
+    pause();
+    _exit(0);
+  }
+  char c;
+  ASSERT_EQ(read(ready[0], &c, 1), 1);
+  EXPECT_EQ(in_child([] {
+              Registration r;
+              Endpoint e;
+              int d = open_device();
+              return !r.reserve(d) && add_publisher(d, "/crowd", 1, &e) == -ENOSPC ? 0 : 1;
+            }),
+            0);
+  kill(holder, SIGKILL);
+  waitpid(holder, nullptr, 0);
+  close(ready[0]);
+  close(ready[1]);
 }
 
 TEST_F(Device, RemoveEndpoint) {
@@ -813,6 +850,95 @@ TEST_F(Device, ExitRecordsPollAndBlock) {
   EXPECT_EQ(rec.pid, child);
   waitpid(child, nullptr, 0);
   close(fd);
+}
+
+TEST_F(Device, PolicyReadBackAndPrivilege) {
+  agnocast_policy get{};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_GET_POLICY, &get), 0);
+  EXPECT_EQ(get.flags, 0u);
+  ASSERT_EQ(
+      set_policy(
+          dev,
+          {{"/a", AGNOCAST_MATCH_CHILDREN, {{user_principal(7), group_principal(8)}}, std::nullopt},
+           {"/b", AGNOCAST_MATCH_EXACT, std::nullopt, {{anyone_principal()}}}},
+          true),
+      0);
+  // Read back by an unprivileged member of the group; too small: -ENOSPC with totals.
+  EXPECT_EQ(
+      in_child([&] {
+        if (!become(kNobody, kNobody, {kAgnocastGroup})) return 10;
+        int d = open_device();
+        agnocast_policy p{};
+        if (ioc(d, AGNOCAST_IOC_GET_POLICY, &p) != -ENOSPC) return 11;
+        if (p.rule_count != 2 || p.principal_count != 3) return 12;
+        std::vector<agnocast_policy_rule> rules(2);
+        std::vector<agnocast_principal> principals(3);
+        p.flags = 0;
+        p.rules = uptr(rules.data());
+        p.principals = uptr(principals.data());
+        if (ioc(d, AGNOCAST_IOC_GET_POLICY, &p)) return 13;
+        if (p.flags != (AGNOCAST_POLICY_PRESENT | AGNOCAST_POLICY_DEFAULT_DENY)) return 14;
+        if (std::string(rules[0].prefix) != "/a" || rules[0].match != AGNOCAST_MATCH_CHILDREN ||
+            rules[0].flags != AGNOCAST_RULE_PUBLISH || rules[0].publish_count != 2)
+          return 15;
+        if (std::string(rules[1].prefix) != "/b" || rules[1].flags != AGNOCAST_RULE_SUBSCRIBE ||
+            rules[1].first_principal != 2 || rules[1].subscribe_count != 1)
+          return 16;
+        if (principals[0].kind != AGNOCAST_PRINCIPAL_USER || principals[0].id != 7 ||
+            principals[1].kind != AGNOCAST_PRINCIPAL_GROUP || principals[1].id != 8 ||
+            principals[2].kind != AGNOCAST_PRINCIPAL_ANYONE)
+          return 17;
+        // Not allowed to set one.
+        agnocast_policy none{};
+        return ioc(d, AGNOCAST_IOC_SET_POLICY, &none) == -EPERM ? 0 : 18;
+      }),
+      0);
+  agnocast_policy none{};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_SET_POLICY, &none), 0);
+}
+
+TEST_F(Device, PolicyRejectsBadInput) {
+  agnocast_principal p[2] = {user_principal(1), anyone_principal()};
+  agnocast_policy_rule rule{};
+  std::strcpy(rule.prefix, "/ok");
+  rule.flags = AGNOCAST_RULE_PUBLISH;
+  rule.publish_count = 1;
+  auto attempt = [&](auto change) {
+    agnocast_policy_rule r = rule;
+    agnocast_principal pr[2] = {p[0], p[1]};
+    agnocast_policy policy{AGNOCAST_POLICY_PRESENT, 1, 2, 0, uptr(&r), uptr(pr)};
+    change(policy, r, pr);
+    return ioc(dev, AGNOCAST_IOC_SET_POLICY, &policy);
+  };
+  using P = agnocast_policy;
+  using R = agnocast_policy_rule;
+  using A = agnocast_principal*;
+  EXPECT_EQ(attempt([](P&, R&, A) {}), 0);
+  EXPECT_EQ(attempt([](P& p, R&, A) { p.reserved = 1; }), -EINVAL);
+  EXPECT_EQ(attempt([](P& p, R&, A) { p.flags |= 1u << 7; }), -EINVAL);
+  EXPECT_EQ(attempt([](P& p, R&, A) { p.rule_count = AGNOCAST_POLICY_RULES_MAX + 1; }), -EINVAL);
+  EXPECT_EQ(attempt([](P& p, R&, A) { p.principal_count = AGNOCAST_POLICY_PRINCIPALS_MAX + 1; }),
+            -EINVAL);
+  EXPECT_EQ(attempt([](P& p, R&, A) { p.rules = 8; }), -EFAULT);
+  EXPECT_EQ(attempt([](P&, R& r, A) { std::strcpy(r.prefix, "/bad//name"); }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { std::strcpy(r.prefix, "/trailing/"); }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { std::memset(r.prefix, 'a', sizeof(r.prefix)); }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.prefix[0] = '\0'; }), -EINVAL);  // exact root
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.match = 3; }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.flags = 4; }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.reserved = 1; }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.subscribe_count = 1; }), -EINVAL);  // not flagged
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.first_principal = 2; }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R& r, A) { r.first_principal = 0xffffffffu; }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R&, A a) { a[0].kind = 9; }), -EINVAL);
+  EXPECT_EQ(attempt([](P&, R&, A a) { a[1].id = 5; }), -EINVAL);            // anyone with an id
+  EXPECT_EQ(attempt([](P&, R&, A a) { a[0].id = 0xffffffffu; }), -EINVAL);  // unmapped uid
+  agnocast_policy removal_with_rules{0, 1, 0, 0, 0, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_SET_POLICY, &removal_with_rules), -EINVAL);
+  agnocast_policy get{1, 0, 0, 0, 0, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_GET_POLICY, &get), -EINVAL);
+  agnocast_policy none{};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_SET_POLICY, &none), 0);
 }
 
 TEST_F(Device, MovedToAnotherIpcNamespaceIsExdev) {

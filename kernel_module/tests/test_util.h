@@ -3,6 +3,7 @@
 
 #include <agnocast.h>
 #include <fcntl.h>
+#include <grp.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/ioctl.h>
@@ -16,11 +17,15 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 namespace agnocast_test {
+
+inline constexpr gid_t kAgnocastGroup = 990;  // the VM's group agnocast, given the device
+inline constexpr uid_t kNobody = 65534;
 
 inline constexpr uint8_t kPoison = 0xA5;
 
@@ -281,5 +286,50 @@ inline int in_child(const std::function<int()> &fn)
   if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
   return WEXITSTATUS(status);
 }
+
+// Becomes @uid with primary group @gid and the supplementary @groups.
+inline bool become(uid_t uid, gid_t gid, std::vector<gid_t> groups = {}) {
+  return setgroups(groups.size(), groups.data()) == 0 && setgid(gid) == 0 && setuid(uid) == 0;
+}
+
+// Policy helpers: one rule with its publish and subscribe principals.
+struct Rule {
+  std::string prefix;
+  uint32_t match;
+  std::optional<std::vector<agnocast_principal>> publish, subscribe;
+};
+
+inline int set_policy(int dev, const std::vector<Rule>& rules, bool default_deny = false) {
+  std::vector<agnocast_policy_rule> raw;
+  std::vector<agnocast_principal> principals;
+  for (const Rule& rule : rules) {
+    agnocast_policy_rule r{};
+    std::strncpy(r.prefix, rule.prefix.c_str(), sizeof(r.prefix) - 1);
+    r.match = rule.match;
+    r.first_principal = static_cast<uint32_t>(principals.size());
+    if (rule.publish) {
+      r.flags |= AGNOCAST_RULE_PUBLISH;
+      r.publish_count = static_cast<uint32_t>(rule.publish->size());
+      principals.insert(principals.end(), rule.publish->begin(), rule.publish->end());
+    }
+    if (rule.subscribe) {
+      r.flags |= AGNOCAST_RULE_SUBSCRIBE;
+      r.subscribe_count = static_cast<uint32_t>(rule.subscribe->size());
+      principals.insert(principals.end(), rule.subscribe->begin(), rule.subscribe->end());
+    }
+    raw.push_back(r);
+  }
+  agnocast_policy policy{};
+  policy.flags = AGNOCAST_POLICY_PRESENT | (default_deny ? AGNOCAST_POLICY_DEFAULT_DENY : 0);
+  policy.rule_count = static_cast<uint32_t>(raw.size());
+  policy.rules = uptr(raw.data());
+  policy.principal_count = static_cast<uint32_t>(principals.size());
+  policy.principals = uptr(principals.data());
+  return ioc(dev, AGNOCAST_IOC_SET_POLICY, &policy);
+}
+
+inline constexpr agnocast_principal user_principal(uint32_t uid) { return {AGNOCAST_PRINCIPAL_USER, uid}; }
+inline constexpr agnocast_principal group_principal(uint32_t gid) { return {AGNOCAST_PRINCIPAL_GROUP, gid}; }
+inline constexpr agnocast_principal anyone_principal() { return {AGNOCAST_PRINCIPAL_ANYONE, 0}; }
 
 }  // namespace agnocast_test

@@ -17,8 +17,6 @@ using namespace agnocast_test;
 
 namespace {
 
-constexpr gid_t kAgnocastGroup = 990;  // the VM's group agnocast (udev gives it the device)
-constexpr uid_t kNobody = 65534;
 constexpr uint64_t kMagic = 0x7472757374000000ull;
 
 // A child's findings, as text through a pipe, so a failure says what failed.
@@ -48,11 +46,6 @@ class Report {
  private:
   int fds_[2] = {-1, -1};
 };
-
-// Becomes @uid with primary group @gid and the supplementary @groups.
-bool become(uid_t uid, gid_t gid, std::vector<gid_t> groups = {}) {
-  return setgroups(groups.size(), groups.data()) == 0 && setgid(gid) == 0 && setuid(uid) == 0;
-}
 
 // Waits for a byte from the other side of @fds.
 bool wait_byte(int fd) {
@@ -108,11 +101,12 @@ TEST_F(Trust, NoOtherProcessCanWriteAPool) {
     ASSERT_EQ(pipe(published), 0);
     pid_t child = fork();
     if (child == 0) {
+      munmap(reg.map, reg.size);  // the publisher's writable mapping, inherited
       if (attacker == 0 && !become(kNobody, kNobody, {kAgnocastGroup})) _exit(10);
       Registration r;
       Endpoint sub;
       int d = open_device();
-      if (d < 0 || r.full(d) || add_subscriber(d, "/trust/pool", 4, &sub)) _exit(11);
+      if (d < 0 || r.reserve(d) || add_subscriber(d, "/trust/pool", 4, &sub)) _exit(11);
       (void)!write(subscribed[1], "s", 1);
       if (!wait_byte(published[0])) _exit(12);
       ReceiveResult rr;
@@ -185,46 +179,6 @@ TEST_F(Trust, NoOtherProcessCanWriteAPool) {
   }
 }
 
-// Policy helpers: one rule with its publish and subscribe principals.
-struct Rule {
-  std::string prefix;
-  uint32_t match;
-  std::optional<std::vector<agnocast_principal>> publish, subscribe;
-};
-
-int set_policy(int dev, const std::vector<Rule>& rules, bool default_deny = false) {
-  std::vector<agnocast_policy_rule> raw;
-  std::vector<agnocast_principal> principals;
-  for (const Rule& rule : rules) {
-    agnocast_policy_rule r{};
-    std::strncpy(r.prefix, rule.prefix.c_str(), sizeof(r.prefix) - 1);
-    r.match = rule.match;
-    r.first_principal = static_cast<uint32_t>(principals.size());
-    if (rule.publish) {
-      r.flags |= AGNOCAST_RULE_PUBLISH;
-      r.publish_count = static_cast<uint32_t>(rule.publish->size());
-      principals.insert(principals.end(), rule.publish->begin(), rule.publish->end());
-    }
-    if (rule.subscribe) {
-      r.flags |= AGNOCAST_RULE_SUBSCRIBE;
-      r.subscribe_count = static_cast<uint32_t>(rule.subscribe->size());
-      principals.insert(principals.end(), rule.subscribe->begin(), rule.subscribe->end());
-    }
-    raw.push_back(r);
-  }
-  agnocast_policy policy{};
-  policy.flags = AGNOCAST_POLICY_PRESENT | (default_deny ? AGNOCAST_POLICY_DEFAULT_DENY : 0);
-  policy.rule_count = static_cast<uint32_t>(raw.size());
-  policy.rules = uptr(raw.data());
-  policy.principal_count = static_cast<uint32_t>(principals.size());
-  policy.principals = uptr(principals.data());
-  return ioc(dev, AGNOCAST_IOC_SET_POLICY, &policy);
-}
-
-constexpr agnocast_principal user(uint32_t uid) { return {AGNOCAST_PRINCIPAL_USER, uid}; }
-constexpr agnocast_principal group(uint32_t gid) { return {AGNOCAST_PRINCIPAL_GROUP, gid}; }
-constexpr agnocast_principal anyone() { return {AGNOCAST_PRINCIPAL_ANYONE, 0}; }
-
 struct Creds {
   uid_t uid;
   gid_t gid;
@@ -264,12 +218,13 @@ const Creds kOutsider{1003, 1003, {}};
 
 TEST_F(Trust, PolicyDecidesByFirstMatchingRule) {
   ASSERT_EQ(
-      set_policy(
-          dev,
-          {{"/safety", AGNOCAST_MATCH_DESCENDANTS, {{group(2001)}}, {{group(2001), user(1002)}}},
-           {"/cam", AGNOCAST_MATCH_CHILDREN, {{user(1003)}}, std::nullopt},
-           {"/cam/front", AGNOCAST_MATCH_EXACT, {{}}, {{}}},
-           {"/status", AGNOCAST_MATCH_EXACT, {{anyone()}}, {{}}}}),
+      set_policy(dev, {{"/safety",
+                        AGNOCAST_MATCH_DESCENDANTS,
+                        {{group_principal(2001)}},
+                        {{group_principal(2001), user_principal(1002)}}},
+                       {"/cam", AGNOCAST_MATCH_CHILDREN, {{user_principal(1003)}}, std::nullopt},
+                       {"/cam/front", AGNOCAST_MATCH_EXACT, {{}}, {{}}},
+                       {"/status", AGNOCAST_MATCH_EXACT, {{anyone_principal()}}, {{}}}}),
       0);
   // /safety/** : the group publishes, the group and the monitor subscribe.
   EXPECT_EQ(endpoint_as(kSafetyMember, "/safety/brake", true), 0);
@@ -299,15 +254,20 @@ TEST_F(Trust, PolicyDecidesByFirstMatchingRule) {
 }
 
 TEST_F(Trust, PolicyDefaultDenyAndRootPatterns) {
-  ASSERT_EQ(set_policy(dev, {{"", AGNOCAST_MATCH_CHILDREN, {{group(2001)}}, {{anyone()}}}}, true),
-            0);
+  ASSERT_EQ(
+      set_policy(dev,
+                 {{"", AGNOCAST_MATCH_CHILDREN, {{group_principal(2001)}}, {{anyone_principal()}}}},
+                 true),
+      0);
   EXPECT_EQ(endpoint_as(kSafetyMember, "/top", true), 0);
   EXPECT_EQ(endpoint_as(kOutsider, "/top", true), -EACCES);
   EXPECT_EQ(endpoint_as(kOutsider, "/top", false), 0);
   EXPECT_EQ(endpoint_as(kSafetyMember, "/top/deeper", true), -EACCES);  // default deny
   EXPECT_EQ(endpoint_as(kSafetyMember, "/top/deeper", false), -EACCES);
-  ASSERT_EQ(set_policy(dev, {{"", AGNOCAST_MATCH_DESCENDANTS, {{user(1003)}}, std::nullopt}}, true),
-            0);
+  ASSERT_EQ(
+      set_policy(dev, {{"", AGNOCAST_MATCH_DESCENDANTS, {{user_principal(1003)}}, std::nullopt}},
+                 true),
+      0);
   EXPECT_EQ(endpoint_as(kOutsider, "/top/deeper", true), 0);
   EXPECT_EQ(endpoint_as(kOutsider, "/top/deeper", false), -EACCES);
 }
@@ -330,89 +290,6 @@ TEST_F(Trust, PolicyChangeKeepsExistingEndpoints) {
   agnocast_policy none{};
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_SET_POLICY, &none), 0);
   EXPECT_EQ(add_publisher(dev, "/kept", 4, &denied), 0);
-}
-
-TEST_F(Trust, PolicyReadBackAndPrivilege) {
-  agnocast_policy get{};
-  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_GET_POLICY, &get), 0);
-  EXPECT_EQ(get.flags, 0u);
-  ASSERT_EQ(set_policy(dev,
-                       {{"/a", AGNOCAST_MATCH_CHILDREN, {{user(7), group(8)}}, std::nullopt},
-                        {"/b", AGNOCAST_MATCH_EXACT, std::nullopt, {{anyone()}}}},
-                       true),
-            0);
-  // Read back by an unprivileged member of the group; too small: -ENOSPC with totals.
-  EXPECT_EQ(
-      in_child([&] {
-        if (!become(kNobody, kNobody, {kAgnocastGroup})) return 10;
-        int d = open_device();
-        agnocast_policy p{};
-        if (ioc(d, AGNOCAST_IOC_GET_POLICY, &p) != -ENOSPC) return 11;
-        if (p.rule_count != 2 || p.principal_count != 3) return 12;
-        std::vector<agnocast_policy_rule> rules(2);
-        std::vector<agnocast_principal> principals(3);
-        p.flags = 0;
-        p.rules = uptr(rules.data());
-        p.principals = uptr(principals.data());
-        if (ioc(d, AGNOCAST_IOC_GET_POLICY, &p)) return 13;
-        if (p.flags != (AGNOCAST_POLICY_PRESENT | AGNOCAST_POLICY_DEFAULT_DENY)) return 14;
-        if (std::string(rules[0].prefix) != "/a" || rules[0].match != AGNOCAST_MATCH_CHILDREN ||
-            rules[0].flags != AGNOCAST_RULE_PUBLISH || rules[0].publish_count != 2)
-          return 15;
-        if (std::string(rules[1].prefix) != "/b" || rules[1].flags != AGNOCAST_RULE_SUBSCRIBE ||
-            rules[1].first_principal != 2 || rules[1].subscribe_count != 1)
-          return 16;
-        if (principals[0].kind != AGNOCAST_PRINCIPAL_USER || principals[0].id != 7 ||
-            principals[1].kind != AGNOCAST_PRINCIPAL_GROUP || principals[1].id != 8 ||
-            principals[2].kind != AGNOCAST_PRINCIPAL_ANYONE)
-          return 17;
-        // Not allowed to set one.
-        agnocast_policy none{};
-        return ioc(d, AGNOCAST_IOC_SET_POLICY, &none) == -EPERM ? 0 : 18;
-      }),
-      0);
-}
-
-TEST_F(Trust, PolicyRejectsBadInput) {
-  agnocast_principal p[2] = {user(1), anyone()};
-  agnocast_policy_rule rule{};
-  std::strcpy(rule.prefix, "/ok");
-  rule.flags = AGNOCAST_RULE_PUBLISH;
-  rule.publish_count = 1;
-  auto attempt = [&](auto change) {
-    agnocast_policy_rule r = rule;
-    agnocast_principal pr[2] = {p[0], p[1]};
-    agnocast_policy policy{AGNOCAST_POLICY_PRESENT, 1, 2, 0, uptr(&r), uptr(pr)};
-    change(policy, r, pr);
-    return ioc(dev, AGNOCAST_IOC_SET_POLICY, &policy);
-  };
-  using P = agnocast_policy;
-  using R = agnocast_policy_rule;
-  using A = agnocast_principal*;
-  EXPECT_EQ(attempt([](P&, R&, A) {}), 0);
-  EXPECT_EQ(attempt([](P& p, R&, A) { p.reserved = 1; }), -EINVAL);
-  EXPECT_EQ(attempt([](P& p, R&, A) { p.flags |= 1u << 7; }), -EINVAL);
-  EXPECT_EQ(attempt([](P& p, R&, A) { p.rule_count = AGNOCAST_POLICY_RULES_MAX + 1; }), -EINVAL);
-  EXPECT_EQ(attempt([](P& p, R&, A) { p.principal_count = AGNOCAST_POLICY_PRINCIPALS_MAX + 1; }),
-            -EINVAL);
-  EXPECT_EQ(attempt([](P& p, R&, A) { p.rules = 8; }), -EFAULT);
-  EXPECT_EQ(attempt([](P&, R& r, A) { std::strcpy(r.prefix, "/bad//name"); }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { std::strcpy(r.prefix, "/trailing/"); }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { std::memset(r.prefix, 'a', sizeof(r.prefix)); }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.prefix[0] = '\0'; }), -EINVAL);  // exact root
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.match = 3; }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.flags = 4; }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.reserved = 1; }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.subscribe_count = 1; }), -EINVAL);  // not flagged
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.first_principal = 2; }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R& r, A) { r.first_principal = 0xffffffffu; }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R&, A a) { a[0].kind = 9; }), -EINVAL);
-  EXPECT_EQ(attempt([](P&, R&, A a) { a[1].id = 5; }), -EINVAL);            // anyone with an id
-  EXPECT_EQ(attempt([](P&, R&, A a) { a[0].id = 0xffffffffu; }), -EINVAL);  // unmapped uid
-  agnocast_policy removal_with_rules{0, 1, 0, 0, 0, 0};
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_SET_POLICY, &removal_with_rules), -EINVAL);
-  agnocast_policy get{1, 0, 0, 0, 0, 0};
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_GET_POLICY, &get), -EINVAL);
 }
 
 // A slow subscriber's backlog beyond the publisher's depth goes when the
@@ -486,6 +363,8 @@ TEST_F(Trust, DiscardedExitRecordsAreReported) {
               }),
               0);
   }
+  // Read only once every record is queued, so exactly the oldest overflow.
+  ASSERT_TRUE(eventually([&] { return list_processes(dev).empty(); }, 60000));
   const uint32_t total = kProcesses * (kSubscribers + 1);
   const uint32_t lost = total - AGNOCAST_EXIT_RECORDS_MAX;
   std::vector<agnocast_exit_record> records;

@@ -179,7 +179,7 @@ ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf, siz
 		return -EPERM;
 	if (!max)
 		return -EINVAL;
-	out = kvmalloc_array(max, sizeof(*out), GFP_KERNEL);
+	out = kvmalloc_array(max, sizeof(*out), GFP_KERNEL_ACCOUNT);
 	if (!out)
 		return -ENOMEM;
 	ret = mutex_lock_killable(&ns->exit_read_lock);

@@ -42,7 +42,7 @@ int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 
 	ret = -ENOMEM;
 	if (ctx.ns->nr_topics) {
-		topics = kvmalloc_array(ctx.ns->nr_topics, sizeof(*topics), GFP_KERNEL);
+		topics = kvmalloc_array(ctx.ns->nr_topics, sizeof(*topics), GFP_KERNEL_ACCOUNT);
 		if (!topics)
 			goto out_leave;
 	}
@@ -54,7 +54,7 @@ int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 
 	n = min(total, arg.capacity);
 	if (n) {
-		summaries = kvcalloc(n, sizeof(*summaries), GFP_KERNEL);
+		summaries = kvcalloc(n, sizeof(*summaries), GFP_KERNEL_ACCOUNT);
 		if (!summaries)
 			goto out_free;
 	}
@@ -138,12 +138,12 @@ int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg)
 	npub = min(topic->nr_publishers, arg->publisher_capacity);
 	nsub = min(topic->nr_subscribers, arg->subscriber_capacity);
 	if (npub) {
-		pub_infos = kvcalloc(npub, sizeof(*pub_infos), GFP_KERNEL);
+		pub_infos = kvcalloc(npub, sizeof(*pub_infos), GFP_KERNEL_ACCOUNT);
 		if (!pub_infos)
 			goto out_free;
 	}
 	if (nsub) {
-		sub_infos = kvcalloc(nsub, sizeof(*sub_infos), GFP_KERNEL);
+		sub_infos = kvcalloc(nsub, sizeof(*sub_infos), GFP_KERNEL_ACCOUNT);
 		if (!sub_infos)
 			goto out_free;
 	}
@@ -206,7 +206,7 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -ENOMEM;
 	total = ctx.ns->nr_procs;
 	if (total) {
-		infos = kvcalloc(total, sizeof(*infos), GFP_KERNEL);
+		infos = kvcalloc(total, sizeof(*infos), GFP_KERNEL_ACCOUNT);
 		if (!infos)
 			goto out_leave;
 	}

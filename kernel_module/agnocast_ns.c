@@ -10,8 +10,8 @@
  * namespace can have the same key, and the kernel clears its s_fs_info when
  * the namespace dies, which tells us the state is dead.  State is freed when
  * it has no users and no processes and either is idle (no topics, no exit
- * records) or belongs to a dead namespace, whose exit records nobody can
- * read any more.  Dead states left behind by a last user from another
+ * records, no access policy) or belongs to a dead namespace, whose exit
+ * records and policy nobody can use any more.  Dead states left behind by a last user from another
  * namespace are collected at the next open.
  *
  * Locking order (outermost first):
@@ -124,7 +124,8 @@ static bool agnocast_ns_finished(const struct agnocast_ns *ns)
 		return false;
 	if (agnocast_ns_dead(ns))
 		return true;
-	return !ns->nr_topics && !agnocast_exit_records_waiting(ns);
+	/* A live namespace keeps what nobody holds open: its policy, its records. */
+	return !ns->nr_topics && !agnocast_exit_records_waiting(ns) && !ns->policy;
 }
 
 /* Moves finished states to @dead, to be freed after the list lock is dropped. */

@@ -111,8 +111,8 @@ int agnocast_policy_check(const struct agnocast_ns *ns, const char *topic, bool 
 	return (policy->flags & AGNOCAST_POLICY_DEFAULT_DENY) ? -EACCES : 0;
 }
 
-static int agnocast_rule_in(struct agnocast_policy_rule_k *out, const struct agnocast_policy_rule *in,
-			    u32 nr_principals)
+static int agnocast_rule_in(struct agnocast_policy_rule_k *out,
+			    const struct agnocast_policy_rule *in, u32 nr_principals)
 {
 	u64 end;
 
@@ -186,8 +186,8 @@ static struct agnocast_policy_state *agnocast_policy_copy_in(const struct agnoca
 		goto err_free;
 	}
 
-	rules = kvmalloc_array(arg->rule_count, sizeof(*rules), GFP_KERNEL);
-	principals = kvmalloc_array(arg->principal_count, sizeof(*principals), GFP_KERNEL);
+	rules = kvmalloc_array(arg->rule_count, sizeof(*rules), GFP_KERNEL_ACCOUNT);
+	principals = kvmalloc_array(arg->principal_count, sizeof(*principals), GFP_KERNEL_ACCOUNT);
 	if ((arg->rule_count && !rules) || (arg->principal_count && !principals)) {
 		ret = -ENOMEM;
 		goto err_free;
@@ -274,8 +274,8 @@ static int agnocast_policy_copy_out(const struct agnocast_policy_state *policy,
 	copy->flags = policy->flags;
 	copy->nr_rules = policy->nr_rules;
 	copy->nr_principals = policy->nr_principals;
-	copy->rules = kvcalloc(policy->nr_rules, sizeof(*copy->rules), GFP_KERNEL);
-	copy->principals = kvcalloc(policy->nr_principals, sizeof(*copy->principals), GFP_KERNEL);
+	copy->rules = kvcalloc(policy->nr_rules, sizeof(*copy->rules), GFP_KERNEL_ACCOUNT);
+	copy->principals = kvcalloc(policy->nr_principals, sizeof(*copy->principals), GFP_KERNEL_ACCOUNT);
 	if ((policy->nr_rules && !copy->rules) || (policy->nr_principals && !copy->principals))
 		return -ENOMEM;
 	for (i = 0; i < policy->nr_rules; i++) {

@@ -856,10 +856,10 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 	}
 	ret = -ENOMEM;
 	if (n > AGNOCAST_RECEIVE_SMALL) {
-		entries = kvmalloc_array(n, sizeof(*entries), GFP_KERNEL);
-		pools = kvmalloc_array(min(n, arg.pool_capacity), sizeof(*pools), GFP_KERNEL);
+		entries = kvmalloc_array(n, sizeof(*entries), GFP_KERNEL_ACCOUNT);
+		pools = kvmalloc_array(min(n, arg.pool_capacity), sizeof(*pools), GFP_KERNEL_ACCOUNT);
 		pool_objs = kvmalloc_array(min(n, arg.pool_capacity), sizeof(*pool_objs),
-					   GFP_KERNEL);
+					   GFP_KERNEL_ACCOUNT);
 		if (!entries || !pools || !pool_objs)
 			goto out_free;
 	}

@@ -408,6 +408,14 @@ TEST_F(Trust, NamespaceStateEndsWithItsNamespace) {
                 int d = open_device();
                 agnocast_policy get{};
                 if (ioc(d, AGNOCAST_IOC_GET_POLICY, &get) || get.flags) return 11;  // a fresh state
+                // A policy stays while its namespace lives, with nothing open.
+                if (set_policy(d, {}, true)) return 16;
+                close(d);
+                d = open_device();
+                if (ioc(d, AGNOCAST_IOC_GET_POLICY, &get) || !(get.flags & AGNOCAST_POLICY_PRESENT))
+                  return 17;
+                agnocast_policy none{};
+                if (ioc(d, AGNOCAST_IOC_SET_POLICY, &none)) return 18;
                 Registration r;
                 Endpoint ep;
                 if (r.full(d) || add_subscriber(d, "/ns", 1, &ep)) return 12;

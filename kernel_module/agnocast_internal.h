@@ -19,6 +19,7 @@
 #include <linux/list.h>
 #include <linux/mutex.h>
 #include <linux/types.h>
+#include <linux/uidgid.h>
 #include <linux/wait.h>
 #include <linux/workqueue.h>
 
@@ -97,6 +98,7 @@ struct agnocast_proc {
 	bool dying;			/* protected by agnocast_proc_table_lock */
 	pid_t tgid;			/* init-namespace number; the table key */
 	u64 exec_id;
+	kuid_t uid;			/* effective uid at registration */
 	struct pid *pid;
 	struct agnocast_ns *ns;
 	struct work_struct teardown_work;
@@ -143,6 +145,11 @@ struct agnocast_topic {
 	struct list_head entries;	/* by id */
 	unsigned int nr_entries;
 	u64 next_entry_id;
+	/* The type, fixed by the endpoint that created the topic. */
+	u64 type_hash;
+	void *schema;			/* from the first endpoint that had one */
+	u32 schema_size;
+	char type_name[AGNOCAST_TYPE_NAME_MAX];
 	char name[AGNOCAST_TOPIC_NAME_MAX];
 };
 
@@ -275,5 +282,6 @@ struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *n
 int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_topic_schema(struct agnocast_ns *file_ns, void __user *uarg);
 
 #endif /* _AGNOCAST_INTERNAL_H */

@@ -3,9 +3,12 @@
  * agnocast: read-only views of a namespace for the CLI and the daemon.
  *
  * These calls need no registration.  Pids are reported as the caller's pid
- * namespace sees them (0 when it cannot see the process).  Each call builds
- * its answer under the namespace lock (agnocast_ns.lock).
+ * namespace sees them (0 when it cannot see the process), uids as its user
+ * namespace does.  Each call builds its answer in kernel memory under the
+ * namespace lock (agnocast_ns.lock) and copies it out after dropping it.
  */
+#include <linux/cred.h>
+#include <linux/mm.h>
 #include <linux/overflow.h>
 #include <linux/pid.h>
 #include <linux/pid_namespace.h>
@@ -60,14 +63,21 @@ int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 	}
 	for (i = 0; i < n; i++) {
 		memcpy(summaries[i].name, topics[i]->name, sizeof(summaries[i].name));
+		memcpy(summaries[i].type_name, topics[i]->type_name, sizeof(summaries[i].type_name));
+		summaries[i].type_hash = topics[i]->type_hash;
 		summaries[i].publishers = topics[i]->nr_publishers;
 		summaries[i].subscribers = topics[i]->nr_subscribers;
 	}
 	arg.total = total;
+	agnocast_leave(&ctx);
 	ret = 0;
 	if (copy_to_user(u64_to_user_ptr(arg.topics), summaries, array_size(n, sizeof(*summaries))) ||
 	    copy_to_user(uarg, &arg, sizeof(arg)))
 		ret = -EFAULT;
+	kvfree(summaries);
+	kvfree(topics);
+	return ret;
+
 out_free:
 	kvfree(summaries);
 	kvfree(topics);
@@ -88,6 +98,7 @@ static void agnocast_publisher_info_fill(struct agnocast_publisher_info *out,
 	out->published = pub->published;
 	out->published_bytes = pub->published_bytes;
 	out->window = pub->window_len;
+	out->uid = from_kuid_munged(current_user_ns(), pub->proc->uid);
 }
 
 static void agnocast_subscriber_info_fill(struct agnocast_subscriber_info *out,
@@ -103,79 +114,87 @@ static void agnocast_subscriber_info_fill(struct agnocast_subscriber_info *out,
 	out->held = sub->nr_held;
 	out->received = sub->received;
 	out->dropped = sub->dropped;
+	out->uid = from_kuid_munged(current_user_ns(), sub->proc->uid);
+}
+
+/* Answers of TOPIC_INFO, built under the namespace lock. */
+struct agnocast_topic_answer {
+	struct agnocast_publisher_info *pubs;
+	struct agnocast_subscriber_info *subs;
+	u32 npub;
+	u32 nsub;
+};
+
+static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_topic_info *arg,
+				     struct agnocast_topic_answer *answer)
+{
+	struct pid_namespace *pid_ns = task_active_pid_ns(current);
+	struct agnocast_subscriber *sub;
+	struct agnocast_publisher *pub;
+	struct agnocast_topic *topic;
+	u32 i;
+
+	lockdep_assert_held(&ns->lock);
+	topic = agnocast_topic_find(ns, arg->name);
+	if (!topic || !(topic->nr_publishers || topic->nr_subscribers))
+		return -ENOENT;
+	answer->npub = min(topic->nr_publishers, arg->publisher_capacity);
+	answer->nsub = min(topic->nr_subscribers, arg->subscriber_capacity);
+	answer->pubs = kvcalloc(answer->npub, sizeof(*answer->pubs), GFP_KERNEL_ACCOUNT);
+	answer->subs = kvcalloc(answer->nsub, sizeof(*answer->subs), GFP_KERNEL_ACCOUNT);
+	if ((answer->npub && !answer->pubs) || (answer->nsub && !answer->subs))
+		return -ENOMEM;
+	i = 0;
+	list_for_each_entry(pub, &topic->publishers, topic_node) {
+		if (i == answer->npub)
+			break;
+		agnocast_publisher_info_fill(&answer->pubs[i++], pub, pid_ns);
+	}
+	i = 0;
+	list_for_each_entry(sub, &topic->subscribers, topic_node) {
+		if (i == answer->nsub)
+			break;
+		agnocast_subscriber_info_fill(&answer->subs[i++], sub, pid_ns);
+	}
+	arg->publisher_total = topic->nr_publishers;
+	arg->subscriber_total = topic->nr_subscribers;
+	arg->entries = topic->nr_entries;
+	memcpy(arg->type_name, topic->type_name, sizeof(arg->type_name));
+	arg->type_hash = topic->type_hash;
+	arg->schema_size = topic->schema_size;
+	return 0;
 }
 
 int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	struct pid_namespace *pid_ns = task_active_pid_ns(current);
-	struct agnocast_subscriber_info *sub_infos = NULL;
-	struct agnocast_publisher_info *pub_infos = NULL;
-	struct agnocast_subscriber *sub;
-	struct agnocast_publisher *pub;
+	struct agnocast_topic_answer answer = {};
 	struct agnocast_topic_info *arg;
-	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
-	u32 npub, nsub, i;
 	int ret;
 
 	arg = memdup_user(uarg, sizeof(*arg));
 	if (IS_ERR(arg))
 		return PTR_ERR(arg);
 	ret = -EINVAL;
-	if (arg->reserved || !memchr(arg->name, '\0', sizeof(arg->name)) ||
-	    !agnocast_topic_name_valid(arg->name))
-		goto out_free_arg;
+	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
+		goto out_free;
 	ret = agnocast_enter(&ctx, file_ns, false);
 	if (ret)
-		goto out_free_arg;
+		goto out_free;
+	ret = agnocast_topic_info_build(ctx.ns, arg, &answer);
+	agnocast_leave(&ctx);
+	if (ret)
+		goto out_free;
 
-	ret = -ENOENT;
-	topic = agnocast_topic_find(ctx.ns, arg->name);
-	if (!topic || !(topic->nr_publishers || topic->nr_subscribers))
-		goto out_leave;
-
-	ret = -ENOMEM;
-	npub = min(topic->nr_publishers, arg->publisher_capacity);
-	nsub = min(topic->nr_subscribers, arg->subscriber_capacity);
-	if (npub) {
-		pub_infos = kvcalloc(npub, sizeof(*pub_infos), GFP_KERNEL_ACCOUNT);
-		if (!pub_infos)
-			goto out_free;
-	}
-	if (nsub) {
-		sub_infos = kvcalloc(nsub, sizeof(*sub_infos), GFP_KERNEL_ACCOUNT);
-		if (!sub_infos)
-			goto out_free;
-	}
-	i = 0;
-	list_for_each_entry(pub, &topic->publishers, topic_node) {
-		if (i == npub)
-			break;
-		agnocast_publisher_info_fill(&pub_infos[i++], pub, pid_ns);
-	}
-	i = 0;
-	list_for_each_entry(sub, &topic->subscribers, topic_node) {
-		if (i == nsub)
-			break;
-		agnocast_subscriber_info_fill(&sub_infos[i++], sub, pid_ns);
-	}
-	arg->publisher_total = topic->nr_publishers;
-	arg->subscriber_total = topic->nr_subscribers;
-	arg->entries = topic->nr_entries;
-
-	ret = 0;
-	if (copy_to_user(u64_to_user_ptr(arg->publishers), pub_infos,
-			 array_size(npub, sizeof(*pub_infos))) ||
-	    copy_to_user(u64_to_user_ptr(arg->subscribers), sub_infos,
-			 array_size(nsub, sizeof(*sub_infos))) ||
+	if (copy_to_user(u64_to_user_ptr(arg->publishers), answer.pubs,
+			 array_size(answer.npub, sizeof(*answer.pubs))) ||
+	    copy_to_user(u64_to_user_ptr(arg->subscribers), answer.subs,
+			 array_size(answer.nsub, sizeof(*answer.subs))) ||
 	    copy_to_user(uarg, arg, sizeof(*arg)))
 		ret = -EFAULT;
 out_free:
-	kvfree(sub_infos);
-	kvfree(pub_infos);
-out_leave:
-	agnocast_leave(&ctx);
-out_free_arg:
+	kvfree(answer.subs);
+	kvfree(answer.pubs);
 	kfree(arg);
 	return ret;
 }
@@ -224,12 +243,61 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 
 	n = min(total, arg.capacity);
 	arg.total = total;
+	agnocast_leave(&ctx);
 	ret = 0;
 	if (copy_to_user(u64_to_user_ptr(arg.processes), infos, array_size(n, sizeof(*infos))) ||
 	    copy_to_user(uarg, &arg, sizeof(arg)))
 		ret = -EFAULT;
 	kvfree(infos);
+	return ret;
+
 out_leave:
 	agnocast_leave(&ctx);
+	return ret;
+}
+
+int agnocast_topic_schema(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_topic_schema *arg;
+	struct agnocast_topic *topic;
+	struct agnocast_ctx ctx;
+	void *schema = NULL;
+	int ret;
+
+	arg = memdup_user(uarg, sizeof(*arg));
+	if (IS_ERR(arg))
+		return PTR_ERR(arg);
+	ret = -EINVAL;
+	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
+		goto out_free_arg;
+	ret = agnocast_enter(&ctx, file_ns, false);
+	if (ret)
+		goto out_free_arg;
+	topic = agnocast_topic_find(ctx.ns, arg->name);
+	ret = -ENOENT;
+	if (!topic || !(topic->nr_publishers || topic->nr_subscribers))
+		goto out_leave;
+	ret = -ENODATA;
+	if (!topic->schema)
+		goto out_leave;
+	arg->size = topic->schema_size;
+	ret = -ENOSPC;
+	if (arg->capacity >= arg->size) {
+		ret = -ENOMEM;
+		schema = kvmalloc(topic->schema_size, GFP_KERNEL_ACCOUNT);
+		if (schema) {
+			memcpy(schema, topic->schema, topic->schema_size);
+			ret = 0;
+		}
+	}
+out_leave:
+	agnocast_leave(&ctx);
+	if (!ret && copy_to_user(u64_to_user_ptr(arg->schema), schema, arg->size))
+		ret = -EFAULT;
+	if ((!ret || ret == -ENOSPC) && copy_to_user(uarg, arg, sizeof(*arg)))
+		ret = -EFAULT;
+	kvfree(schema);
+out_free_arg:
+	kfree(arg);
 	return ret;
 }

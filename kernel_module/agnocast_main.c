@@ -137,6 +137,8 @@ static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long ar
 		return agnocast_set_policy(ns, uarg);
 	case AGNOCAST_IOC_GET_POLICY:
 		return agnocast_get_policy(ns, uarg);
+	case AGNOCAST_IOC_TOPIC_SCHEMA:
+		return agnocast_topic_schema(ns, uarg);
 	default:
 		return -ENOTTY;
 	}

@@ -22,6 +22,7 @@
  * The table lock is a spinlock because the exit probe cannot sleep.
  */
 #include <linux/bitmap.h>
+#include <linux/cred.h>
 #include <linux/hashtable.h>
 #include <linux/ipc_namespace.h>
 #include <linux/module.h>
@@ -244,6 +245,7 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 	}
 	proc->tgid = current->tgid;
 	proc->exec_id = current->self_exec_id;
+	proc->uid = current_euid();
 	proc->pid = get_task_pid(current, PIDTYPE_TGID);
 	proc->ns = ns;
 	INIT_WORK(&proc->teardown_work, agnocast_teardown_work);

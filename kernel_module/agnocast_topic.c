@@ -146,6 +146,16 @@ struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *n
 	return NULL;
 }
 
+/* Printable ASCII (the type name may be empty). */
+static bool agnocast_type_name_valid(const char *type_name)
+{
+	for (; *type_name; type_name++) {
+		if (*type_name < 0x21 || *type_name > 0x7e)
+			return false;
+	}
+	return true;
+}
+
 static struct agnocast_topic *agnocast_topic_get(struct agnocast_ns *ns, const char *name)
 {
 	struct agnocast_topic *topic;
@@ -195,6 +205,7 @@ static void agnocast_topic_maybe_free(struct agnocast_topic *topic)
 	hash_del(&topic->hash_node);
 	agnocast_id_space_put(ns, topic->ids);
 	ns->nr_topics--;
+	kvfree(topic->schema);
 	kfree(topic);
 }
 
@@ -417,7 +428,39 @@ static bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg
 		return false;
 	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING))
 		return false;
+	if (!agnocast_str_terminated(arg->type_name, sizeof(arg->type_name)) ||
+	    !agnocast_type_name_valid(arg->type_name))
+		return false;
+	if (arg->schema_size > AGNOCAST_SCHEMA_MAX || arg->reserved)
+		return false;
 	return !(publisher && (arg->flags & AGNOCAST_POLLING));
+}
+
+/*
+ * A new topic takes the endpoint's type; an existing one must have it.  The
+ * schema comes from the first endpoint that brings one (@schema is taken).
+ */
+static int agnocast_topic_type_check(struct agnocast_topic *topic,
+				     const struct agnocast_add_endpoint *arg, void **schema)
+{
+	bool fresh = !topic->nr_publishers && !topic->nr_subscribers && !topic->nr_entries;
+
+	if (fresh) {
+		strscpy(topic->type_name, arg->type_name, sizeof(topic->type_name));
+		topic->type_hash = arg->type_hash;
+		kvfree(topic->schema);
+		topic->schema = NULL;
+		topic->schema_size = 0;
+	} else if (topic->type_hash != arg->type_hash ||
+		   strcmp(topic->type_name, arg->type_name)) {
+		return -EPROTOTYPE;
+	}
+	if (!topic->schema && *schema) {
+		topic->schema = *schema;
+		topic->schema_size = arg->schema_size;
+		*schema = NULL;
+	}
+	return 0;
 }
 
 static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
@@ -429,6 +472,7 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 	struct agnocast_publisher *pub = NULL;
 	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
+	void *schema = NULL;
 	u32 id;
 	int ret;
 
@@ -438,6 +482,15 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 	ret = -EINVAL;
 	if (!agnocast_endpoint_args_valid(arg, publisher))
 		goto out_free_arg;
+	if (arg->schema_size) {
+		schema = kvmalloc(arg->schema_size, GFP_KERNEL_ACCOUNT);
+		ret = -ENOMEM;
+		if (!schema)
+			goto out_free_arg;
+		ret = -EFAULT;
+		if (copy_from_user(schema, u64_to_user_ptr(arg->schema), arg->schema_size))
+			goto out_free_arg;
+	}
 
 	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
@@ -454,6 +507,9 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 		ret = PTR_ERR(topic);
 		goto out_leave;
 	}
+	ret = agnocast_topic_type_check(topic, arg, &schema);
+	if (ret)
+		goto out_put_topic;
 	ret = -ENOSPC;
 	if (publisher ? topic->nr_publishers >= AGNOCAST_PUBLISHERS_PER_TOPIC_MAX :
 			topic->nr_subscribers >= AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX)
@@ -532,6 +588,7 @@ out_put_topic:
 out_leave:
 	agnocast_leave(&ctx);
 out_free_arg:
+	kvfree(schema);
 	kfree(arg);
 	return ret;
 }

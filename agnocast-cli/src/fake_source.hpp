@@ -35,7 +35,8 @@ class FakeSource : public InspectionSource {
     std::vector<TopicSummary> list;
     for (const TopicInfo& t : topics) {
       list.push_back({t.name, static_cast<std::uint32_t>(t.publishers.size()),
-                      static_cast<std::uint32_t>(t.subscribers.size())});
+                      static_cast<std::uint32_t>(t.subscribers.size()), t.type_name,
+                      t.type_hash});
     }
     return list;
   }

@@ -15,7 +15,7 @@ namespace {
 // The ABI: sizes are pinned so that no field moves unnoticed.
 static_assert(sizeof(agnocast_version) == 16);
 static_assert(sizeof(agnocast_register_process) == 24);
-static_assert(sizeof(agnocast_add_endpoint) == 400);
+static_assert(sizeof(agnocast_add_endpoint) == 552);
 static_assert(sizeof(agnocast_remove_endpoint) == 8);
 static_assert(sizeof(agnocast_publish) == 72);
 static_assert(sizeof(agnocast_reclaim) == 24);
@@ -24,11 +24,12 @@ static_assert(sizeof(agnocast_pool) == 24);
 static_assert(sizeof(agnocast_receive) == 48);
 static_assert(sizeof(agnocast_take) == 64);
 static_assert(sizeof(agnocast_release) == 16);
-static_assert(sizeof(agnocast_topic_summary) == 264);
+static_assert(sizeof(agnocast_topic_summary) == 400);
 static_assert(sizeof(agnocast_list_topics) == 16);
 static_assert(sizeof(agnocast_publisher_info) == 168);
-static_assert(sizeof(agnocast_subscriber_info) == 168);
-static_assert(sizeof(agnocast_topic_info) == 296);
+static_assert(sizeof(agnocast_subscriber_info) == 176);
+static_assert(sizeof(agnocast_topic_info) == 432);
+static_assert(sizeof(agnocast_topic_schema) == 272);
 static_assert(sizeof(agnocast_process_info) == 32);
 static_assert(sizeof(agnocast_list_processes) == 16);
 static_assert(sizeof(agnocast_exit_record) == 272);
@@ -237,7 +238,9 @@ TEST_F(Device, AddEndpointsShareIdsPerTopic) {
   EXPECT_EQ(info.publisher_total, 1u);
   EXPECT_EQ(info.subscriber_total, 2u);
   EXPECT_EQ(info.entries, 0u);
-  EXPECT_EQ(info.reserved, 0u);
+  EXPECT_STREQ(info.type_name, "");
+  EXPECT_EQ(info.type_hash, 0u);
+  EXPECT_EQ(info.schema_size, 0u);
   ASSERT_EQ(pubs.size(), 1u);
   EXPECT_STREQ(pubs[0].node, "talker");
   EXPECT_EQ(pubs[0].pid, getpid());
@@ -245,7 +248,7 @@ TEST_F(Device, AddEndpointsShareIdsPerTopic) {
   EXPECT_EQ(pubs[0].flags, 0u);
   EXPECT_EQ(pubs[0].published, 0u);
   EXPECT_EQ(pubs[0].window, 0u);
-  EXPECT_EQ(pubs[0].reserved, 0u);
+  EXPECT_EQ(pubs[0].uid, 0u);
   ASSERT_EQ(subs.size(), 2u);
   EXPECT_EQ(subs[0].id, 1u);
   EXPECT_STREQ(subs[0].node, "listener");
@@ -255,6 +258,88 @@ TEST_F(Device, AddEndpointsShareIdsPerTopic) {
   EXPECT_EQ(subs[1].unreceived, 0u);
   EXPECT_EQ(subs[1].held, 0u);
   EXPECT_EQ(subs[1].dropped, 0u);
+}
+
+// A topic's type is fixed by the endpoint that creates it; later endpoints
+// must name the same type, and the first schema brought stays for tools.
+TEST_F(Device, TopicTypeIsFixedByItsFirstEndpoint) {
+  registered();
+  const std::vector<uint8_t> schema = {'A', 'G', 'S', 'C', 1, 2, 3};
+  auto typed = [&](const std::string& type, uint64_t hash, const std::vector<uint8_t>* blob,
+                   bool publisher) {
+    agnocast_add_endpoint ep = endpoint("/typed", 4);
+    std::strncpy(ep.type_name, type.c_str(), sizeof(ep.type_name) - 1);
+    ep.type_hash = hash;
+    if (blob) {
+      ep.schema = uptr(blob->data());
+      ep.schema_size = static_cast<uint32_t>(blob->size());
+    }
+    return ioc(dev, publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep);
+  };
+  ASSERT_EQ(typed("pkg/msg/A", 0x1111, nullptr, false), 0);  // creates it, without a schema
+  EXPECT_EQ(typed("pkg/msg/A", 0x2222, &schema, true), -EPROTOTYPE);
+  EXPECT_EQ(typed("pkg/msg/B", 0x1111, &schema, true), -EPROTOTYPE);
+  EXPECT_EQ(typed("", 0, nullptr, true), -EPROTOTYPE);
+
+  agnocast_topic_schema ts = poisoned<agnocast_topic_schema>();
+  std::memset(ts.name, 0, sizeof(ts.name));
+  std::strcpy(ts.name, "/typed");
+  std::vector<uint8_t> out(64, kPoison);
+  ts.schema = uptr(out.data());
+  ts.capacity = 64;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_SCHEMA, &ts), -ENODATA);
+  ASSERT_EQ(typed("pkg/msg/A", 0x1111, &schema, true), 0);  // brings the schema
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_SCHEMA, &ts), 0);
+  EXPECT_EQ(ts.size, schema.size());
+  EXPECT_TRUE(std::equal(schema.begin(), schema.end(), out.begin()));
+  EXPECT_EQ(out[schema.size()], kPoison);
+  ts.capacity = 3;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_SCHEMA, &ts), -ENOSPC);
+  EXPECT_EQ(ts.size, schema.size());
+  ts.capacity = 64;
+  ts.schema = uptr(kBadPtr);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_SCHEMA, &ts), -EFAULT);
+  std::strcpy(ts.name, "/untyped");
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_SCHEMA, &ts), -ENOENT);
+
+  agnocast_topic_info info;
+  ASSERT_EQ(topic_info(dev, "/typed", &info), 0);
+  EXPECT_STREQ(info.type_name, "pkg/msg/A");
+  EXPECT_EQ(info.type_hash, 0x1111u);
+  EXPECT_EQ(info.schema_size, schema.size());
+  agnocast_topic_summary topics[4];
+  agnocast_list_topics lt{uptr(topics), 4, 0};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
+  ASSERT_EQ(lt.total, 1u);
+  EXPECT_STREQ(topics[0].type_name, "pkg/msg/A");
+  EXPECT_EQ(topics[0].type_hash, 0x1111u);
+
+  // Bad type names, schema sizes and reserved fields.
+  EXPECT_EQ(typed("has space", 1, nullptr, true), -EINVAL);
+  EXPECT_EQ(typed("tab\t", 1, nullptr, true), -EINVAL);
+  agnocast_add_endpoint ep = endpoint("/typed", 4);
+  std::memset(ep.type_name, 'a', sizeof(ep.type_name));
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  ep = endpoint("/typed", 4);
+  ep.schema_size = AGNOCAST_SCHEMA_MAX + 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  ep = endpoint("/typed", 4);
+  ep.reserved = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  ep = endpoint("/other", 4);
+  ep.schema = uptr(kBadPtr);
+  ep.schema_size = 16;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EFAULT);
+  EXPECT_EQ(topic_info(dev, "/other", &info), -ENOENT);  // nothing left behind
+
+  // Once the topic is gone, it may come back with another type.
+  ASSERT_EQ(ioc0(dev, AGNOCAST_IOC_UNREGISTER_PROCESS), 0);
+  EXPECT_EQ(in_child([&] {
+              Registration r;
+              if (r.reserve(dev)) return 10;
+              return typed("pkg/msg/B", 0x3333, nullptr, true) == 0 ? 0 : 11;
+            }),
+            0);
 }
 
 TEST_F(Device, IdsNeverCollideAcrossMangledNames) {
@@ -758,9 +843,9 @@ TEST_F(Device, Introspection) {
   std::strcpy(info.name, "/zeta");
   info.publisher_capacity = 0;
   info.subscriber_capacity = 0;
-  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info), -EINVAL);  // reserved poisoned
-  info.reserved = 0;
-  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info), 0);
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info), 0);  // outputs overwritten
+  EXPECT_STREQ(info.type_name, "");
+  EXPECT_EQ(info.schema_size, 0u);
   EXPECT_EQ(info.publisher_total, 1u);
   EXPECT_EQ(info.subscriber_total, 0u);
   std::memset(info.name, 'z', sizeof(info.name));

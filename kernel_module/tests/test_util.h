@@ -116,6 +116,11 @@ inline agnocast_add_endpoint endpoint(const std::string &topic, uint32_t depth,
   agnocast_add_endpoint ep = poisoned<agnocast_add_endpoint>();
   std::memset(ep.topic, 0, sizeof(ep.topic));
   std::memset(ep.node, 0, sizeof(ep.node));
+  std::memset(ep.type_name, 0, sizeof(ep.type_name));
+  ep.type_hash = 0;
+  ep.schema = 0;
+  ep.schema_size = 0;
+  ep.reserved = 0;
   std::strncpy(ep.topic, topic.c_str(), sizeof(ep.topic) - 1);
   std::strncpy(ep.node, node.c_str(), sizeof(ep.node) - 1);
   ep.depth = depth;
@@ -227,7 +232,6 @@ inline int topic_info(int dev, const std::string &name, agnocast_topic_info *inf
   info->subscribers = uptr(s.data());
   info->publisher_capacity = 64;
   info->subscriber_capacity = 64;
-  info->reserved = 0;
   int ret = ioc(dev, AGNOCAST_IOC_TOPIC_INFO, info);
   if (!ret && pubs) pubs->assign(p.begin(), p.begin() + std::min(64u, info->publisher_total));
   if (!ret && subs) subs->assign(s.begin(), s.begin() + std::min(64u, info->subscriber_total));

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <string_view>
 #include <utility>
@@ -23,6 +24,8 @@ ModuleNotLoaded::ModuleNotLoaded()
             " missing): run `systemctl start agnocastd`") {}
 
 AccessDenied::AccessDenied(const std::string& message) : DeviceError(EACCES, message) {}
+
+TypeMismatch::TypeMismatch(const std::string& message) : DeviceError(EPROTOTYPE, message) {}
 
 }  // namespace agnocast
 
@@ -95,10 +98,19 @@ std::string bounded_string(const char* text, std::size_t capacity) {
   return std::string(text, ::strnlen(text, capacity));
 }
 
-agnocast_add_endpoint make_endpoint_request(const EndpointRequest& request) {
+agnocast_add_endpoint to_uapi(const EndpointRequest& request) {
   agnocast_add_endpoint argument{};
   copy_name(argument.topic, sizeof argument.topic, request.topic, "topic name");
   copy_name(argument.node, sizeof argument.node, request.node, "node name");
+  copy_name(argument.type_name, sizeof argument.type_name, request.type_name, "message type name");
+  argument.type_hash = request.type_hash;
+  if (request.schema.size() > AGNOCAST_SCHEMA_MAX) {
+    throw std::invalid_argument("the schema of message type " + request.type_name + " has " +
+                                std::to_string(request.schema.size()) + " bytes: at most " +
+                                std::to_string(AGNOCAST_SCHEMA_MAX));
+  }
+  argument.schema = reinterpret_cast<std::uintptr_t>(request.schema.data());
+  argument.schema_size = static_cast<std::uint32_t>(request.schema.size());
   argument.depth = request.depth;
   argument.flags = (request.transient_local ? AGNOCAST_TRANSIENT_LOCAL : 0U) |
                    (request.polling ? AGNOCAST_POLLING : 0U);
@@ -120,15 +132,37 @@ std::string add_endpoint_advice(int err, const EndpointRequest& request, std::st
              "/etc/agnocast/agnocastd.json)";
     case EINVAL:
       return "the module refused topic '" + request.topic + "', node '" + request.node +
-             "' or depth " + std::to_string(request.depth) + " (1.." + std::to_string(depth_max) +
-             ")";
+             "', message type '" + request.type_name + "' or depth " +
+             std::to_string(request.depth) + " (1.." + std::to_string(depth_max) + ")";
     default:
       return {};
   }
 }
 
-[[noreturn]] void fail_add_endpoint(std::string_view command, int err,
+std::string hex(std::uint64_t value) {
+  char text[19];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+[[noreturn]] void fail_add_endpoint(const Device& device, std::string_view command, int err,
                                     const EndpointRequest& request, std::string_view kind) {
+  if (err == EPROTOTYPE) {
+    std::string topic_type = "another type";
+    TopicInfo info;
+    try {
+      if (device.topic_info(request.topic, info)) {
+        topic_type = "'" + info.type_name + "' (layout hash " + hex(info.type_hash) + ")";
+      }
+    } catch (const DeviceError&) {
+      // The message below still says what this endpoint wanted.
+    }
+    throw TypeMismatch("agnocast: " + std::string(command) + " failed: topic " + request.topic +
+                       " carries " + topic_type + ", but this " + std::string(kind) + " uses '" +
+                       request.type_name + "' (layout hash " + hex(request.type_hash) +
+                       "): use the topic's message type, or rebuild both programs against the "
+                       "same definition of it");
+  }
   if (err == EACCES) {
     throw AccessDenied(
         "agnocast: " + std::string(command) + " failed: the topic access policy does not let " +
@@ -270,17 +304,17 @@ void Device::unregister_process() const {
 }
 
 EndpointId Device::add_publisher(const EndpointRequest& request) const {
-  agnocast_add_endpoint argument = make_endpoint_request(request);
+  agnocast_add_endpoint argument = to_uapi(request);
   if (int err = call(fd_, AGNOCAST_IOC_ADD_PUBLISHER, &argument)) {
-    fail_add_endpoint("ADD_PUBLISHER", err, request, "publisher");
+    fail_add_endpoint(*this, "ADD_PUBLISHER", err, request, "publisher");
   }
   return EndpointId{argument.topic_handle, argument.id};
 }
 
 EndpointId Device::add_subscriber(const EndpointRequest& request) const {
-  agnocast_add_endpoint argument = make_endpoint_request(request);
+  agnocast_add_endpoint argument = to_uapi(request);
   if (int err = call(fd_, AGNOCAST_IOC_ADD_SUBSCRIBER, &argument)) {
-    fail_add_endpoint("ADD_SUBSCRIBER", err, request, "subscriber");
+    fail_add_endpoint(*this, "ADD_SUBSCRIBER", err, request, "subscriber");
   }
   return EndpointId{argument.topic_handle, argument.id};
 }
@@ -490,10 +524,26 @@ std::vector<TopicSummary> Device::list_topics() const {
   }
   std::vector<TopicSummary> topics;
   for (std::uint32_t i = 0; i < argument.total; ++i) {
-    topics.push_back(
-        {bounded_string(raw[i].name, sizeof raw[i].name), raw[i].publishers, raw[i].subscribers});
+    topics.push_back({bounded_string(raw[i].name, sizeof raw[i].name), raw[i].publishers,
+                      raw[i].subscribers,
+                      bounded_string(raw[i].type_name, sizeof raw[i].type_name),
+                      raw[i].type_hash});
   }
   return topics;
+}
+
+std::optional<std::vector<std::uint8_t>> Device::topic_schema(const std::string& topic) const {
+  std::vector<std::uint8_t> schema(AGNOCAST_SCHEMA_MAX);
+  agnocast_topic_schema argument{};
+  copy_name(argument.name, sizeof argument.name, topic, "topic name");
+  argument.schema = reinterpret_cast<std::uintptr_t>(schema.data());
+  argument.capacity = static_cast<std::uint32_t>(schema.size());
+  if (int err = call(fd_, AGNOCAST_IOC_TOPIC_SCHEMA, &argument)) {
+    if (err == ENOENT || err == ENODATA) return std::nullopt;
+    fail("TOPIC_SCHEMA", err);
+  }
+  schema.resize(argument.size);
+  return schema;
 }
 
 bool Device::topic_info(const std::string& topic, TopicInfo& info) const {
@@ -521,19 +571,23 @@ bool Device::topic_info(const std::string& topic, TopicInfo& info) const {
   info = TopicInfo{};
   info.name = topic;
   info.entries = argument.entries;
+  info.type_name = bounded_string(argument.type_name, sizeof argument.type_name);
+  info.type_hash = argument.type_hash;
+  info.schema_size = argument.schema_size;
   for (std::uint32_t i = 0; i < argument.publisher_total; ++i) {
     const auto& raw = publishers[i];
     info.publishers.push_back(PublisherInfo{raw.id, raw.pid,
                                             bounded_string(raw.node, sizeof raw.node), raw.depth,
                                             (raw.flags & AGNOCAST_TRANSIENT_LOCAL) != 0,
-                                            raw.published, raw.published_bytes, raw.window});
+                                            raw.published, raw.published_bytes, raw.window,
+                                            raw.uid});
   }
   for (std::uint32_t i = 0; i < argument.subscriber_total; ++i) {
     const auto& raw = subscribers[i];
     info.subscribers.push_back(SubscriberInfo{
         raw.id, raw.pid, bounded_string(raw.node, sizeof raw.node), raw.depth,
         (raw.flags & AGNOCAST_TRANSIENT_LOCAL) != 0, (raw.flags & AGNOCAST_POLLING) != 0,
-        raw.unreceived, raw.held, raw.received, raw.dropped});
+        raw.unreceived, raw.held, raw.received, raw.dropped, raw.uid});
   }
   return true;
 }

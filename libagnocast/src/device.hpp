@@ -38,6 +38,10 @@ struct EndpointRequest {
   std::uint32_t depth = 1;
   bool transient_local = false;
   bool polling = false;
+  // The message type: the topic's must be the same (TypeMismatch otherwise).
+  std::string type_name;
+  std::uint64_t type_hash = 0;
+  std::span<const std::uint8_t> schema;  // kept by the kernel for tools; may be empty
 };
 
 struct PublishResult {
@@ -132,6 +136,9 @@ class Device {
   void set_policy(const std::optional<AccessPolicy>& policy) const;
 
   std::vector<TopicSummary> list_topics() const;
+  // The schema a topic's endpoints registered; nullopt when it has none or
+  // no such topic has an endpoint.
+  std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic) const;
   // Returns false when no topic of that name has an endpoint.
   bool topic_info(const std::string& topic, TopicInfo& info) const;
   std::vector<ProcessInfo> list_processes() const;

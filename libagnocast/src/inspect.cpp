@@ -27,4 +27,8 @@ std::optional<TopicInfo> topic_info(const std::string& topic) {
 
 std::vector<ProcessInfo> list_processes() { return detail::Device::open().list_processes(); }
 
+std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic) {
+  return detail::Device::open().topic_schema(topic);
+}
+
 }  // namespace agnocast

@@ -41,6 +41,9 @@
 /* Including the terminating NUL. */
 #define AGNOCAST_TOPIC_NAME_MAX 256
 #define AGNOCAST_NODE_NAME_MAX 128
+#define AGNOCAST_TYPE_NAME_MAX 128
+/* A topic's schema: an opaque description of its type, for tools. */
+#define AGNOCAST_SCHEMA_MAX 4096
 
 #define AGNOCAST_DEPTH_MAX 1024
 #define AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX 1024
@@ -110,11 +113,19 @@ struct agnocast_register_process {
  *      names are equal once every '/' after the first is mapped to '_', so
  *      that their notification queue names never collide.
  *
+ * A topic has one message type, fixed by the endpoint that creates it: its
+ * type_name (printable ASCII, may be empty) and type_hash, and, from the
+ * first endpoint that brings one, its schema (schema_size bytes at schema,
+ * at most AGNOCAST_SCHEMA_MAX).  A later endpoint must name the same type.
+ *
  * A subscriber with AGNOCAST_TRANSIENT_LOCAL joining a topic receives, as its
  * first unreceived entries, up to depth of the newest entries still in the
  * window of publishers that are transient-local too.
  *
- *   -EINVAL  bad name, label, depth or flags (POLLING on a publisher)
+ *   -EINVAL  bad name, label, type name, depth, flags (POLLING on a
+ *            publisher), schema_size or reserved
+ *   -EPROTOTYPE the topic's type has another name or hash (TOPIC_INFO tells
+ *            which)
  *   -ENOSPC  the topic has PUBLISHERS/SUBSCRIBERS_PER_TOPIC_MAX endpoints
  *   -ENFILE  the namespace has max_topics_per_namespace topics (module
  *            parameter) and this would be a new one
@@ -126,10 +137,15 @@ struct agnocast_register_process {
 struct agnocast_add_endpoint {
 	char topic[AGNOCAST_TOPIC_NAME_MAX];
 	char node[AGNOCAST_NODE_NAME_MAX];
+	char type_name[AGNOCAST_TYPE_NAME_MAX];
+	__u64 type_hash;
+	__u64 schema;
+	__u32 schema_size;
 	__u32 depth;
 	__u32 flags;
 	__u32 topic_handle;
 	__u32 id;
+	__u32 reserved;
 };
 
 /*
@@ -355,6 +371,8 @@ struct agnocast_policy {
 
 struct agnocast_topic_summary {
 	char name[AGNOCAST_TOPIC_NAME_MAX];
+	char type_name[AGNOCAST_TYPE_NAME_MAX];
+	__u64 type_hash;
 	__u32 publishers;
 	__u32 subscribers;
 };
@@ -371,6 +389,7 @@ struct agnocast_list_topics {
 	__u32 total;
 };
 
+/* uid: the owning process's effective uid when it registered. */
 struct agnocast_publisher_info {
 	char node[AGNOCAST_NODE_NAME_MAX];
 	__u32 id;
@@ -380,7 +399,7 @@ struct agnocast_publisher_info {
 	__u64 published;
 	__u64 published_bytes;
 	__u32 window;
-	__u32 reserved;
+	__u32 uid;
 };
 
 struct agnocast_subscriber_info {
@@ -393,6 +412,8 @@ struct agnocast_subscriber_info {
 	__u32 held;
 	__u64 received;
 	__u64 dropped;
+	__u32 uid;
+	__u32 reserved;
 };
 
 /*
@@ -400,12 +421,14 @@ struct agnocast_subscriber_info {
  *
  * in:  name; publishers/subscribers arrays and their capacities.
  * out: totals and the first min(total, capacity) endpoints by id; entries,
- *      the number of live entries of the topic.
+ *      the number of live entries of the topic; its type and schema size.
  *
  *   -ENOENT  no topic of that name has an endpoint
  */
 struct agnocast_topic_info {
 	char name[AGNOCAST_TOPIC_NAME_MAX];
+	char type_name[AGNOCAST_TYPE_NAME_MAX];
+	__u64 type_hash;
 	__u64 publishers;
 	__u64 subscribers;
 	__u32 publisher_capacity;
@@ -413,7 +436,24 @@ struct agnocast_topic_info {
 	__u32 publisher_total;
 	__u32 subscriber_total;
 	__u32 entries;
-	__u32 reserved;
+	__u32 schema_size;
+};
+
+/*
+ * AGNOCAST_IOC_TOPIC_SCHEMA: the schema of a topic.
+ *
+ * in:  name; schema/capacity, a buffer.  out: size, the schema's size; the
+ *      schema in the buffer.
+ *
+ *   -ENOENT  no topic of that name has an endpoint
+ *   -ENODATA the topic has no schema
+ *   -ENOSPC  capacity is below size (size is set)
+ */
+struct agnocast_topic_schema {
+	char name[AGNOCAST_TOPIC_NAME_MAX];
+	__u64 schema;
+	__u32 capacity;
+	__u32 size;
 };
 
 struct agnocast_process_info {
@@ -458,6 +498,7 @@ struct agnocast_list_processes {
 #define AGNOCAST_IOC_SHED _IOR(AGNOCAST_IOC_MAGIC, 15, struct agnocast_shed)
 #define AGNOCAST_IOC_SET_POLICY _IOW(AGNOCAST_IOC_MAGIC, 16, struct agnocast_policy)
 #define AGNOCAST_IOC_GET_POLICY _IOWR(AGNOCAST_IOC_MAGIC, 17, struct agnocast_policy)
+#define AGNOCAST_IOC_TOPIC_SCHEMA _IOWR(AGNOCAST_IOC_MAGIC, 18, struct agnocast_topic_schema)
 
 /*
  * Exit records: read() on /dev/agnocast returns whole records, oldest first,

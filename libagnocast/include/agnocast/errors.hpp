@@ -42,6 +42,13 @@ class AccessDenied : public DeviceError {
   explicit AccessDenied(const std::string& message);
 };
 
+// The topic carries another message type (name or layout hash) than this
+// endpoint; what() names the topic and both types.
+class TypeMismatch : public DeviceError {
+ public:
+  explicit TypeMismatch(const std::string& message);
+};
+
 // A POSIX message queue could not be created or opened (often a system limit).
 class QueueError : public Error {
  public:

@@ -18,6 +18,8 @@ struct TopicSummary {
   std::string name;
   std::uint32_t publishers = 0;
   std::uint32_t subscribers = 0;
+  std::string type_name;  // the message type its first endpoint fixed
+  std::uint64_t type_hash = 0;
 };
 
 struct PublisherInfo {
@@ -29,6 +31,7 @@ struct PublisherInfo {
   std::uint64_t published = 0;
   std::uint64_t published_bytes = 0;
   std::uint32_t window = 0;  // entries currently in the publisher's depth window
+  uid_t uid = 0;             // the publishing process's effective uid
 };
 
 struct SubscriberInfo {
@@ -42,6 +45,7 @@ struct SubscriberInfo {
   std::uint32_t held = 0;
   std::uint64_t received = 0;
   std::uint64_t dropped = 0;
+  uid_t uid = 0;  // the subscribing process's effective uid
 };
 
 struct TopicInfo {
@@ -49,6 +53,9 @@ struct TopicInfo {
   std::vector<PublisherInfo> publishers;
   std::vector<SubscriberInfo> subscribers;
   std::uint32_t entries = 0;  // live message entries of the topic
+  std::string type_name;
+  std::uint64_t type_hash = 0;
+  std::uint32_t schema_size = 0;  // bytes of the registered schema, 0 when none
 };
 
 struct ProcessInfo {
@@ -68,5 +75,8 @@ std::vector<TopicSummary> list_topics();
 // nullopt when no topic of that name has an endpoint.
 std::optional<TopicInfo> topic_info(const std::string& topic);
 std::vector<ProcessInfo> list_processes();
+// The schema blob the topic's endpoints registered (see schema.hpp);
+// nullopt when it has none or no such topic has an endpoint.
+std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic);
 
 }  // namespace agnocast

@@ -8,6 +8,7 @@ struct Reading {
   double value = 0;
   agnocast::vector<agnocast::string> labels;
 };
+AGNOCAST_MESSAGE(Reading, "consumer/msg/Reading", value, labels);
 
 int main() {
   // Instantiating the templates is the point: no device is needed to compile them.

@@ -12,8 +12,9 @@ namespace msggen {
 // A mistake in an input file, located for the user: what() is "file:line: message".
 class InputError : public std::runtime_error {
  public:
+  // line 0: about the file as a whole.
   InputError(const std::string& file, int line, const std::string& message)
-      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message) {}
+      : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message) {}
 };
 
 enum class BaseType {

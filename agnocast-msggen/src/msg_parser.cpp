@@ -45,6 +45,22 @@ bool is_lower_identifier(std::string_view name) {
   return name.back() != '_' && name.find("__") == std::string_view::npos;
 }
 
+bool is_cpp_keyword(std::string_view name) {
+  static const std::set<std::string_view> keywords{
+      "alignas",   "alignof",   "and",       "asm",       "auto",     "bool",     "break",
+      "case",      "catch",     "char",      "class",     "concept",  "const",    "consteval",
+      "constexpr", "constinit", "continue",  "decltype",  "default",  "delete",   "do",
+      "double",    "else",      "enum",      "explicit",  "export",   "extern",   "false",
+      "float",     "for",       "friend",    "goto",      "if",       "inline",   "int",
+      "long",      "mutable",   "namespace", "new",       "noexcept", "not",      "nullptr",
+      "operator",  "or",        "private",   "protected", "public",   "register", "requires",
+      "return",    "short",     "signed",    "sizeof",    "static",   "struct",   "switch",
+      "template",  "this",      "throw",     "true",      "try",      "typedef",  "typeid",
+      "typename",  "union",     "unsigned",  "using",     "virtual",  "void",     "volatile",
+      "while",     "xor"};
+  return keywords.contains(name);
+}
+
 bool is_constant_name(std::string_view name) {
   if (name.empty() || !std::isupper(static_cast<unsigned char>(name.front()))) return false;
   for (const char c : name) {
@@ -245,6 +261,9 @@ class Parser {
           "with a letter",
           name));
     }
+    if (is_cpp_keyword(name)) {
+      throw std::invalid_argument(fmt::format("field name '{}' is a C++ keyword", name));
+    }
     claim_name(name);
     Field field{type, std::string(name), std::nullopt, std::move(comments), line_number};
     if (!default_text.empty()) field.default_initializer = cpp_value(type, default_text);
@@ -269,6 +288,16 @@ bool is_primitive(BaseType type) { return type != BaseType::String && type != Ba
 
 MessageSpec parse_message(std::string_view text, const std::string& file,
                           const std::string& package, const std::string& name) {
+  if (!is_lower_identifier(package)) {
+    throw InputError(file, 0,
+                     fmt::format("bad package name '{}': lower case letters, digits and "
+                                 "single underscores",
+                                 package));
+  }
+  if (!is_type_name(name)) {
+    throw InputError(file, 0,
+                     fmt::format("bad message name '{}': CamelCase letters and digits", name));
+  }
   return Parser(file, package, name).run(text);
 }
 

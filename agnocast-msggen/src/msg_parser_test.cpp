@@ -99,8 +99,24 @@ TEST(MsgParser, ErrorsNameFileLineAndCause) {
             "p/msg/M.msg:1: the string has 3 characters, more than its bound 2");
   EXPECT_EQ(error_of("int32 a\n---\n"),
             "p/msg/M.msg:2: '---' separates a service or action, not allowed in a .msg file");
+  EXPECT_EQ(error_of("int32 class\n"), "p/msg/M.msg:1: field name 'class' is a C++ keyword");
   EXPECT_EQ(error_of("Other[] X=1\n"),
             "p/msg/M.msg:1: a constant must have a primitive or string type");
+}
+
+TEST(MsgParser, BadMessageOrPackageNameIsAboutTheFile) {
+  EXPECT_THROW(
+      {
+        try {
+          parse_message("int32 a\n", "x/lower.msg", "p", "lower");
+        } catch (const InputError& error) {
+          EXPECT_STREQ(error.what(),
+                       "x/lower.msg: bad message name 'lower': CamelCase letters and digits");
+          throw;
+        }
+      },
+      InputError);
+  EXPECT_THROW(parse_message("int32 a\n", "x/M.msg", "Pkg", "M"), InputError);
 }
 
 TEST(MessageSet, UnknownTypeNamesWhereToLook) {

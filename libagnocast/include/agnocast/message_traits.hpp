@@ -207,6 +207,10 @@ concept Publishable = requires {
   "agnocast::string/agnocast::vector and declare the struct with AGNOCAST_MESSAGE, or "      \
   "generate it from a .msg file."
 
+#define AGNOCAST_DETAIL_NESTED_SEQUENCE_RULE                                           \
+  "agnocast: an array or sequence of sequences has no schema (as in ROS 2); wrap the " \
+  "inner agnocast::vector in a struct declared with AGNOCAST_MESSAGE"
+
 namespace detail {
 
 template <class T>
@@ -299,6 +303,7 @@ constexpr FieldDescriptor describe_field(std::string_view name, std::size_t offs
                         nullptr};
   if constexpr (detail::is_agnocast_vector<F>) {
     using E = typename detail::SequenceElement<F>::type;
+    static_assert(!detail::is_agnocast_vector<E>, AGNOCAST_DETAIL_NESTED_SEQUENCE_RULE);
     static_assert(!std::is_same_v<E, bool>,
                   "agnocast: agnocast::vector<bool> packs bits and cannot be read in place; use "
                   "agnocast::vector<std::uint8_t>");
@@ -310,6 +315,7 @@ constexpr FieldDescriptor describe_field(std::string_view name, std::size_t offs
     field.nested = detail::element_descriptor<E>();
   } else if constexpr (requires { detail::ArrayElement<F>::length; }) {
     using E = typename detail::ArrayElement<F>::type;
+    static_assert(!detail::is_agnocast_vector<E>, AGNOCAST_DETAIL_NESTED_SEQUENCE_RULE);
     static_assert(detail::is_field_element<E>, AGNOCAST_PUBLISHABLE_RULE);
     field.shape = FieldShape::Array;
     field.kind = detail::element_kind<E>();

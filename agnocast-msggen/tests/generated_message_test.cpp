@@ -93,4 +93,15 @@ TEST(GeneratedMessage, HashTellsDefinitionsApart) {
   EXPECT_EQ(message_traits<int>::type_hash, message_traits<float>::type_hash);
 }
 
+TEST(GeneratedMessage, HashIsStable) {
+  // Programs built by different agnocast releases meet on one topic: the hash of
+  // a layout must not drift. Change these only together with the recipe's tag
+  // ("agnocast-type-v1"/"agnocast-raw-v1" in message_traits.hpp).
+  EXPECT_EQ(message_traits<std::uint32_t>::type_hash, 0xc1f6888313b183edULL);
+#if defined(__x86_64__) && defined(__GLIBCXX__) && _GLIBCXX_USE_CXX11_ABI
+  EXPECT_EQ(message_traits<golden_msgs::msg::Tire>::type_hash, 0x932c77e9b3d56ddaULL);
+  EXPECT_EQ(message_traits<Wheel>::type_hash, 0xedea4a7db3387b16ULL);
+#endif
+}
+
 }  // namespace

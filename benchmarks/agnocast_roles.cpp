@@ -26,6 +26,15 @@ struct BenchMessage {
   agnocast::vector<std::uint8_t> payload;
 };
 
+}  // namespace
+}  // namespace agnocast::bench
+
+AGNOCAST_MESSAGE(agnocast::bench::BenchMessage, "agnocast_bench/msg/BenchMessage", seq, t0_ns,
+                 payload);
+
+namespace agnocast::bench {
+namespace {
+
 std::string next_topic(const char* kind) {
   static int run = 0;
   return std::string("/bench/") + kind + "_" + std::to_string(getpid()) + "_" +

@@ -15,6 +15,12 @@ struct Message {
   agnocast::vector<std::uint8_t> payload;
 };
 
+}  // namespace chatter
+
+AGNOCAST_MESSAGE(chatter::Message, "chatter/msg/Message", seq, checksum, payload);
+
+namespace chatter {
+
 inline std::uint64_t mix(std::uint64_t value) {  // splitmix64's finalizer
   value += 0x9E3779B97F4A7C15ULL;
   value = (value ^ (value >> 30)) * 0xBF58476D1CE4E5B9ULL;

@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the library from the build tree into a scratch prefix, then builds
-# and runs a tiny consumer with find_package and with pkg-config.
+# and runs a tiny consumer with find_package and with pkg-config; the CMake
+# consumer also generates its own message with agnocast_generate_messages().
 # usage: consumer_test.sh BUILD_DIR CONSUMER_SOURCE_DIR SCRATCH_DIR
 set -eu
 build=$1 source=$2 scratch=$3
@@ -19,6 +20,8 @@ pcdir=$(dirname "$(find "$prefix" -name agnocast.pc | head -n1)")
 export PKG_CONFIG_PATH=$pcdir
 test "$(pkg-config --modversion agnocast)" = "$(LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/consumer" | cut -d' ' -f2)"
 # shellcheck disable=SC2046 # pkg-config output is meant to be split
-c++ -std=c++20 -o "$scratch/consumer-pc" "$source/main.cpp" $(pkg-config --cflags --libs agnocast)
+# (its own message headers are the ones agnocast-msggen generated for the CMake build)
+c++ -std=c++20 -o "$scratch/consumer-pc" "$source/main.cpp" \
+  -I"$scratch/cmake-build/agnocast_messages/consumer_msgs" $(pkg-config --cflags --libs agnocast)
 LD_LIBRARY_PATH=$libdir "$scratch/consumer-pc" | grep -q '^agnocast '
 echo "consumer builds with find_package and pkg-config"

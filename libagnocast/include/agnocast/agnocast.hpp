@@ -5,6 +5,7 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/executor.hpp"
 #include "agnocast/ipc_shared_ptr.hpp"
+#include "agnocast/message.hpp"
 #include "agnocast/naming.hpp"
 #include "agnocast/node.hpp"
 #include "agnocast/publisher.hpp"

@@ -5,6 +5,7 @@
 #include <string_view>
 #include <utility>
 
+#include "agnocast/message_traits.hpp"
 #include "agnocast/publisher.hpp"
 #include "agnocast/qos.hpp"
 #include "agnocast/subscription.hpp"
@@ -25,12 +26,14 @@ class Node {
 
   template <class T>
   std::shared_ptr<Publisher<T>> create_publisher(std::string_view topic, const QoS& qos) {
+    static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
     return std::make_shared<Publisher<T>>(state_, topic, qos);
   }
 
   template <class T, class Callback>
   std::shared_ptr<Subscription<T>> create_subscription(std::string_view topic, const QoS& qos,
                                                        Callback&& callback) {
+    static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
     auto subscription = std::make_shared<Subscription<T>>(
         state_, topic, qos, typename Subscription<T>::Callback(std::forward<Callback>(callback)));
     detail::register_subscription(*state_, subscription);
@@ -40,6 +43,7 @@ class Node {
   template <class T>
   std::shared_ptr<PollingSubscriber<T>> create_polling_subscriber(std::string_view topic,
                                                                   const QoS& qos) {
+    static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
     return std::make_shared<PollingSubscriber<T>>(state_, topic, qos);
   }
 

@@ -1,0 +1,84 @@
+# agnocast_generate_messages(<target> PACKAGE <package> FILES <file.msg>...
+#                            [DEPENDENCIES <package or target>...])
+#
+# Generates <package>/msg/<snake_case>.hpp for each .msg file and makes <target>,
+# an INTERFACE library to link: it carries the include folder, agnocast::agnocast
+# and the targets of the dependencies. The FILES of one package live in one folder.
+# A dependency is a target made by this function, or a package of the standard
+# set (builtin_interfaces, std_msgs, geometry_msgs, sensor_msgs: agnocast::<name>).
+
+# "PointCloud2" -> "point_cloud2", the rule of agnocast-msggen's snake_case().
+function(_agnocast_snake_case name out)
+  string(REGEX REPLACE "([A-Z])([A-Z][a-z])" "\\1_\\2" name "${name}")
+  string(REGEX REPLACE "([a-z0-9])([A-Z])" "\\1_\\2" name "${name}")
+  string(TOLOWER "${name}" name)
+  set(${out} "${name}" PARENT_SCOPE)
+endfunction()
+
+function(agnocast_generate_messages target)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "PACKAGE" "FILES;DEPENDENCIES")
+  if(NOT arg_PACKAGE OR NOT arg_FILES)
+    message(FATAL_ERROR "agnocast_generate_messages(${target}): PACKAGE and FILES are required")
+  endif()
+  if(TARGET agnocast-msggen)
+    set(generator agnocast-msggen)  # building agnocast itself
+  else()
+    set(generator agnocast::agnocast-msggen)
+  endif()
+
+  set(output_dir ${CMAKE_CURRENT_BINARY_DIR}/agnocast_messages/${target})
+  set(inputs "")
+  set(headers "")
+  foreach(file IN LISTS arg_FILES)
+    get_filename_component(file "${file}" ABSOLUTE)
+    get_filename_component(name "${file}" NAME_WE)
+    _agnocast_snake_case(${name} snake)
+    list(APPEND inputs ${file})
+    list(APPEND headers ${output_dir}/${arg_PACKAGE}/msg/${snake}.hpp)
+  endforeach()
+  list(GET inputs 0 first_input)
+  get_filename_component(msg_dir "${first_input}" DIRECTORY)
+
+  # Every package reachable through the dependencies, as PKG=DIR for --include.
+  set(includes "${arg_PACKAGE}=${msg_dir}")
+  set(dependency_targets "")
+  set(dependency_files "")
+  foreach(dependency IN LISTS arg_DEPENDENCIES)
+    if(TARGET ${dependency})
+      set(dependency_target ${dependency})
+    elseif(TARGET agnocast::${dependency})
+      set(dependency_target agnocast::${dependency})
+    else()
+      message(FATAL_ERROR "agnocast_generate_messages(${target}): no message package "
+                          "'${dependency}' (a target of agnocast_generate_messages or agnocast::<name>)")
+    endif()
+    get_target_property(dependency_includes ${dependency_target} AGNOCAST_MSG_INCLUDES)
+    list(APPEND includes ${dependency_includes})
+    list(APPEND dependency_targets ${dependency_target})
+    foreach(include IN LISTS dependency_includes)
+      string(REGEX REPLACE "^[^=]*=" "" folder "${include}")
+      file(GLOB folder_files "${folder}/*.msg")
+      list(APPEND dependency_files ${folder_files})
+    endforeach()
+  endforeach()
+  list(REMOVE_DUPLICATES includes)
+  set(include_options "")
+  foreach(include IN LISTS includes)
+    list(APPEND include_options --include ${include})
+  endforeach()
+
+  add_custom_command(
+    OUTPUT ${headers}
+    COMMAND $<TARGET_FILE:${generator}> --package ${arg_PACKAGE} --output-dir ${output_dir} ${include_options}
+            ${inputs}
+    DEPENDS ${inputs} ${dependency_files} ${generator}
+    COMMENT "Generating agnocast messages of ${arg_PACKAGE}"
+    VERBATIM)
+  add_library(${target} INTERFACE ${headers})
+  target_include_directories(${target} INTERFACE $<BUILD_INTERFACE:${output_dir}>)
+  target_link_libraries(${target} INTERFACE agnocast::agnocast ${dependency_targets})
+  set_target_properties(${target} PROPERTIES
+    AGNOCAST_MSG_INCLUDES "${includes}"
+    AGNOCAST_PACKAGE ${arg_PACKAGE}
+    AGNOCAST_HEADER_DIR ${output_dir})
+endfunction()

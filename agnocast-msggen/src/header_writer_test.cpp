@@ -1,0 +1,53 @@
+#include "header_writer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "message_set.hpp"
+
+namespace msggen {
+namespace {
+
+const std::filesystem::path golden = GOLDEN_DIR;
+const std::filesystem::path standard = std::filesystem::path(GOLDEN_DIR) / "../../../messages";
+
+std::string read(const std::filesystem::path& path) {
+  std::ifstream stream(path);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+TEST(HeaderWriter, SnakeCaseFollowsRos2) {
+  EXPECT_EQ(snake_case("PointCloud2"), "point_cloud2");
+  EXPECT_EQ(snake_case("PoseStamped"), "pose_stamped");
+  EXPECT_EQ(snake_case("Imu"), "imu");
+  EXPECT_EQ(snake_case("TFMessage"), "tf_message");
+  EXPECT_EQ(snake_case("Vector3"), "vector3");
+  EXPECT_EQ(header_path("wheel_msgs", "Wheel"), "wheel_msgs/msg/wheel.hpp");
+}
+
+// Regenerate the expected files with: agnocast-msggen --package golden_msgs
+//   --output-dir tests/golden/expected --include std_msgs=... --include geometry_msgs=...
+//   tests/golden/golden_msgs/msg/*.msg
+TEST(HeaderWriter, MatchesGoldenHeaders) {
+  MessageSet set;
+  for (const char* package : {"std_msgs", "geometry_msgs", "builtin_interfaces"}) {
+    set.add_package_folder(package, standard / package / "msg");
+  }
+  for (const char* name : {"Empty", "Tire", "Wheel"}) {
+    set.add_input("golden_msgs", golden / "golden_msgs/msg" / (std::string(name) + ".msg"));
+  }
+  set.resolve();
+  ASSERT_EQ(set.inputs().size(), 3u);
+  for (const MessageSpec& spec : set.inputs()) {
+    const auto expected = golden / "expected" / header_path(spec.package, spec.name);
+    EXPECT_EQ(write_header(spec), read(expected)) << "differs from " << expected;
+  }
+}
+
+}  // namespace
+}  // namespace msggen

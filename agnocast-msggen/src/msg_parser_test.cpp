@@ -1,0 +1,155 @@
+#include "msg_parser.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "message_set.hpp"
+
+namespace msggen {
+namespace {
+
+MessageSpec parse(std::string_view text) { return parse_message(text, "p/msg/M.msg", "p", "M"); }
+
+// The error message of parsing `text`, or "" when it parses.
+std::string error_of(std::string_view text) {
+  try {
+    parse(text);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(MsgParser, ReadsFieldsConstantsAndContainers) {
+  const MessageSpec spec = parse(
+      "# about M\n\n"
+      "int32 ANSWER=42\n"
+      "# the stamp\n"
+      "builtin_interfaces/Time stamp\n"
+      "Other other  # same package\n"
+      "string<=5[<=3] names\n"
+      "float64[4] values\n"
+      "uint8[] data\n");
+  EXPECT_EQ(spec.comments, std::vector<std::string>{"about M"});
+  ASSERT_EQ(spec.constants.size(), 1u);
+  EXPECT_EQ(spec.constants[0].name, "ANSWER");
+  EXPECT_EQ(spec.constants[0].initializer, "42");
+  ASSERT_EQ(spec.fields.size(), 5u);
+  EXPECT_EQ(spec.fields[0].type.package, "builtin_interfaces");
+  EXPECT_EQ(spec.fields[0].comments, std::vector<std::string>{"the stamp"});
+  EXPECT_EQ(spec.fields[1].type.package, "p");
+  EXPECT_EQ(spec.fields[1].type.name, "Other");
+  EXPECT_EQ(spec.fields[1].comments, std::vector<std::string>{"same package"});
+  EXPECT_EQ(spec.fields[2].type.base, BaseType::String);
+  EXPECT_EQ(spec.fields[2].type.string_bound, 5u);
+  EXPECT_EQ(spec.fields[2].type.container, Container::Sequence);
+  EXPECT_EQ(spec.fields[2].type.length, 3u);
+  EXPECT_EQ(spec.fields[3].type.container, Container::FixedArray);
+  EXPECT_EQ(spec.fields[3].type.length, 4u);
+  EXPECT_EQ(spec.fields[4].type.container, Container::Sequence);
+  EXPECT_EQ(spec.fields[4].type.length, 0u);
+  EXPECT_EQ(spec.fields[4].line, 9);
+}
+
+TEST(MsgParser, TurnsDefaultsIntoCppValues) {
+  const MessageSpec spec = parse(
+      "float32 f 0.1\nfloat64 d 1\nbool b True\nint64 i -9223372036854775808\n"
+      "string s 'it''s'\nstring t \"a\\\"b\"\nint8[2] a [1, -1]\n");
+  EXPECT_EQ(*spec.fields[0].default_initializer, "0.1F");
+  EXPECT_EQ(*spec.fields[1].default_initializer, "1.0");
+  EXPECT_EQ(*spec.fields[2].default_initializer, "true");
+  EXPECT_EQ(*spec.fields[3].default_initializer, "(-9223372036854775807LL - 1)");
+  EXPECT_EQ(*spec.fields[5].default_initializer, "\"a\\\"b\"");
+  EXPECT_EQ(*spec.fields[6].default_initializer, "{1, -1}");
+}
+
+TEST(MsgParser, StringConstantKeepsHashes) {
+  const MessageSpec spec = parse("string S=a # b\nint32 I=3 # three\n");
+  EXPECT_EQ(spec.constants[0].initializer, "\"a # b\"");
+  EXPECT_EQ(spec.constants[1].initializer, "3");
+}
+
+TEST(MsgParser, EmptyMessageGetsThePlaceholderMember) {
+  const MessageSpec spec = parse("# nothing\n");
+  ASSERT_EQ(spec.fields.size(), 1u);
+  EXPECT_EQ(spec.fields[0].name, "structure_needs_at_least_one_member");
+}
+
+TEST(MsgParser, ErrorsNameFileLineAndCause) {
+  EXPECT_EQ(error_of("int32 a\nfloat33 b\n"),
+            "p/msg/M.msg:2: unknown type 'float33': not a primitive type, and not a message name "
+            "(CamelCase)");
+  EXPECT_EQ(error_of("string<=0 s\n"),
+            "p/msg/M.msg:1: bad string bound '0': expected a positive integer below 2^32");
+  EXPECT_EQ(error_of("int32[<=x] a\n"),
+            "p/msg/M.msg:1: bad array bound 'x': expected a positive integer below 2^32");
+  EXPECT_EQ(
+      error_of("int32[99999999999] a\n"),
+      "p/msg/M.msg:1: bad array length '99999999999': expected a positive integer below 2^32");
+  EXPECT_EQ(error_of("int32 a\n\nint64 a\n"), "p/msg/M.msg:3: duplicate field or constant 'a'");
+  EXPECT_EQ(error_of("int32\n"), "p/msg/M.msg:1: expected 'type name', got 'int32'");
+  EXPECT_EQ(error_of("int32 Bad\n"),
+            "p/msg/M.msg:1: bad field name 'Bad': lower case letters, digits and single "
+            "underscores, starting with a letter");
+  EXPECT_EQ(error_of("uint8 u 256\n"), "p/msg/M.msg:1: 256 is out of range [0, 255]");
+  EXPECT_EQ(error_of("int32[2] a [1]\n"),
+            "p/msg/M.msg:1: the array has 1 elements, its type needs 2");
+  EXPECT_EQ(error_of("string<=2 s abc\n"),
+            "p/msg/M.msg:1: the string has 3 characters, more than its bound 2");
+  EXPECT_EQ(error_of("int32 a\n---\n"),
+            "p/msg/M.msg:2: '---' separates a service or action, not allowed in a .msg file");
+  EXPECT_EQ(error_of("int32 class\n"), "p/msg/M.msg:1: field name 'class' is a C++ keyword");
+  EXPECT_EQ(error_of("Other[] X=1\n"),
+            "p/msg/M.msg:1: a constant must have a primitive or string type");
+}
+
+TEST(MsgParser, BadMessageOrPackageNameIsAboutTheFile) {
+  EXPECT_THROW(
+      {
+        try {
+          parse_message("int32 a\n", "x/lower.msg", "p", "lower");
+        } catch (const InputError& error) {
+          EXPECT_STREQ(error.what(),
+                       "x/lower.msg: bad message name 'lower': CamelCase letters and digits");
+          throw;
+        }
+      },
+      InputError);
+  EXPECT_THROW(parse_message("int32 a\n", "x/M.msg", "Pkg", "M"), InputError);
+}
+
+TEST(MessageSet, UnknownTypeNamesWhereToLook) {
+  const std::filesystem::path golden = GOLDEN_DIR;
+  MessageSet set;
+  set.add_input("golden_msgs", golden / "golden_msgs/msg/Wheel.msg");
+  try {
+    set.resolve();
+    FAIL() << "resolved without the folders of std_msgs and golden_msgs";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              (golden / "golden_msgs/msg/Wheel.msg").string() +
+                  ":10: unknown type 'std_msgs/Header': no Header.msg among the inputs or in the "
+                  "folders given for package 'std_msgs' (DEPENDENCIES / --include)");
+  }
+}
+
+TEST(MessageSet, CyclicIncludeShowsTheChain) {
+  const std::filesystem::path cyclic =
+      std::filesystem::path(GOLDEN_DIR) / "../cyclic/cyclic_msgs/msg";
+  MessageSet set;
+  set.add_input("cyclic_msgs", cyclic / "A.msg");
+  set.add_package_folder("cyclic_msgs", cyclic);
+  try {
+    set.resolve();
+    FAIL() << "a cycle was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              (cyclic / "C.msg").string() +
+                  ":1: cyclic include: cyclic_msgs/A -> cyclic_msgs/B -> cyclic_msgs/C -> "
+                  "cyclic_msgs/A");
+  }
+}
+
+}  // namespace
+}  // namespace msggen

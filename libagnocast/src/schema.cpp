@@ -1,0 +1,320 @@
+#include "agnocast/schema.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string_view>
+
+namespace agnocast {
+namespace {
+
+constexpr std::size_t header_bytes = 20;
+constexpr std::size_t type_fixed_bytes = 8 + 4 + 4 + 2 + 1;
+constexpr std::size_t field_fixed_bytes = 1 + 1 + 1 + 2 + 7 * 4;
+
+// Same layout as agnocast::allocator (stateless), but on the heap: for probing.
+template <class T>
+struct HeapAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = HeapAllocator<U>;
+  };
+  HeapAllocator() = default;
+  template <class U>
+  HeapAllocator(const HeapAllocator<U>&) noexcept {}
+};
+using ProbeVector = std::vector<std::uint64_t, HeapAllocator<std::uint64_t>>;
+using ProbeString = std::basic_string<char, std::char_traits<char>, HeapAllocator<char>>;
+static_assert(sizeof(ProbeVector) == sizeof(agnocast::vector<std::uint64_t>));
+static_assert(sizeof(ProbeString) == sizeof(agnocast::string));
+
+// Where in `object` a word equal to `value` is.
+template <class Object>
+std::uint8_t offset_of_word(const Object& object, std::uintptr_t value) {
+  for (std::size_t offset = 0; offset + sizeof(value) <= sizeof(Object); offset += sizeof(value)) {
+    std::uintptr_t word;
+    std::memcpy(&word, reinterpret_cast<const char*>(&object) + offset, sizeof(word));
+    if (word == value) return static_cast<std::uint8_t>(offset);
+  }
+  throw std::logic_error("agnocast: unknown container layout in this standard library");
+}
+
+ContainerLayout probe_container_layout() {
+  ProbeVector vector(3);
+  ProbeString string(40, 'x');  // longer than any small-string buffer
+  ContainerLayout layout;
+  layout.pointer_size = sizeof(void*);
+  layout.vector_size = sizeof(ProbeVector);
+  layout.vector_begin_offset =
+      offset_of_word(vector, reinterpret_cast<std::uintptr_t>(vector.data()));
+  layout.vector_end_offset =
+      offset_of_word(vector, reinterpret_cast<std::uintptr_t>(vector.data() + vector.size()));
+  layout.string_size = sizeof(ProbeString);
+  layout.string_data_offset =
+      offset_of_word(string, reinterpret_cast<std::uintptr_t>(string.data()));
+  layout.string_length_offset = offset_of_word(string, string.size());
+  return layout;
+}
+
+class BlobWriter {
+ public:
+  void u8(std::uint8_t value) { bytes_.push_back(value); }
+  void u16(std::uint16_t value) { little_endian(value, 2); }
+  void u32(std::uint32_t value) { little_endian(value, 4); }
+  void u64(std::uint64_t value) { little_endian(value, 8); }
+  void name(std::string_view text) {
+    if (text.empty() || text.size() > 255) {
+      throw SchemaError("agnocast: schema names must have 1 to 255 characters: '" +
+                        std::string(text) + "'");
+    }
+    u8(static_cast<std::uint8_t>(text.size()));
+    bytes_.insert(bytes_.end(), text.begin(), text.end());
+  }
+  std::vector<std::uint8_t>& bytes() { return bytes_; }
+
+ private:
+  void little_endian(std::uint64_t value, int size) {
+    for (int i = 0; i < size; ++i) bytes_.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+  }
+  std::vector<std::uint8_t> bytes_;
+};
+
+// Every type reachable from `type`, each after all the types it uses (post-order).
+void collect_types(const TypeDescriptor& type, std::vector<const TypeDescriptor*>& order) {
+  if (std::find(order.begin(), order.end(), &type) != order.end()) return;
+  for (const FieldDescriptor& field : type.fields) {
+    if (field.nested != nullptr) collect_types(*field.nested, order);
+  }
+  order.push_back(&type);
+}
+
+class BlobReader {
+ public:
+  explicit BlobReader(std::span<const std::uint8_t> blob) : blob_(blob) {}
+  std::uint8_t u8() { return static_cast<std::uint8_t>(little_endian(1)); }
+  std::uint16_t u16() { return static_cast<std::uint16_t>(little_endian(2)); }
+  std::uint32_t u32() { return static_cast<std::uint32_t>(little_endian(4)); }
+  std::uint64_t u64() { return little_endian(8); }
+  std::string name() {
+    const std::size_t length = u8();
+    need(length);
+    std::string text(reinterpret_cast<const char*>(blob_.data() + position_), length);
+    position_ += length;
+    if (text.empty() ||
+        !std::all_of(text.begin(), text.end(), [](char c) { return c > ' ' && c < 127; })) {
+      throw SchemaError("schema: a name is empty or not printable");
+    }
+    return text;
+  }
+  bool at_end() const { return position_ == blob_.size(); }
+
+ private:
+  void need(std::size_t bytes) const {
+    if (bytes > blob_.size() - position_) throw SchemaError("schema: truncated");
+  }
+  std::uint64_t little_endian(int size) {
+    need(static_cast<std::size_t>(size));
+    std::uint64_t value = 0;
+    for (int i = 0; i < size; ++i) {
+      value |= static_cast<std::uint64_t>(blob_[position_ + i]) << (8 * i);
+    }
+    position_ += static_cast<std::size_t>(size);
+    return value;
+  }
+  std::span<const std::uint8_t> blob_;
+  std::size_t position_ = 0;
+};
+
+void fail(const SchemaType& type, const SchemaField& field, const char* what) {
+  throw SchemaError("schema: " + type.name + "." + field.name + ": " + what);
+}
+
+std::uint32_t element_size_of(FieldKind kind, const ContainerLayout& containers) {
+  switch (kind) {
+    case FieldKind::Bool:
+    case FieldKind::Int8:
+    case FieldKind::UInt8:
+      return 1;
+    case FieldKind::Int16:
+    case FieldKind::UInt16:
+      return 2;
+    case FieldKind::Int32:
+    case FieldKind::UInt32:
+    case FieldKind::Float32:
+      return 4;
+    case FieldKind::Int64:
+    case FieldKind::UInt64:
+    case FieldKind::Float64:
+      return 8;
+    case FieldKind::String:
+      return containers.string_size;
+    default:
+      return 0;  // Message and Opaque: checked against their own size
+  }
+}
+
+void check_field(const Schema& schema, std::size_t type_index, const SchemaField& field) {
+  const SchemaType& type = schema.types[type_index];
+  const auto kind = static_cast<std::uint8_t>(field.kind);
+  if (kind < static_cast<std::uint8_t>(FieldKind::Bool) ||
+      kind > static_cast<std::uint8_t>(FieldKind::Opaque)) {
+    fail(type, field, "unknown kind");
+  }
+  if (static_cast<std::uint8_t>(field.shape) > static_cast<std::uint8_t>(FieldShape::Sequence)) {
+    fail(type, field, "unknown shape");
+  }
+  if (field.kind == FieldKind::Message) {
+    if (field.nested <= type_index || field.nested >= schema.types.size()) {
+      fail(type, field, "nested type index out of order");
+    }
+    if (schema.types[field.nested].size != field.element_size) {
+      fail(type, field, "element size differs from the nested type's size");
+    }
+  } else if (field.nested != schema_no_type) {
+    fail(type, field, "nested type on a field that is not a message");
+  }
+  if (const std::uint32_t expected = element_size_of(field.kind, schema.containers);
+      expected != 0 && expected != field.element_size) {
+    fail(type, field, "element size does not match its kind");
+  }
+  if (field.element_size == 0) fail(type, field, "zero element size");
+  if (static_cast<std::uint64_t>(field.offset) + field.size > type.size) {
+    fail(type, field, "field beyond the end of its type");
+  }
+  switch (field.shape) {
+    case FieldShape::Single:
+      if (field.size != field.element_size) fail(type, field, "size differs from element size");
+      break;
+    case FieldShape::Array:
+      if (static_cast<std::uint64_t>(field.element_size) * field.array_length != field.size) {
+        fail(type, field, "array size is not element size times length");
+      }
+      break;
+    case FieldShape::Sequence:
+      if (field.size != schema.containers.vector_size) fail(type, field, "not a vector's size");
+      break;
+  }
+}
+
+}  // namespace
+
+const ContainerLayout& native_container_layout() {
+  static const ContainerLayout layout = probe_container_layout();
+  return layout;
+}
+
+std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
+  // Reversed post-order: the message type first, every type before the types it uses.
+  std::vector<const TypeDescriptor*> sorted;
+  collect_types(root, sorted);
+  std::reverse(sorted.begin(), sorted.end());
+  std::map<const TypeDescriptor*, std::uint16_t> index;
+  for (std::size_t i = 0; i < sorted.size(); ++i) index[sorted[i]] = static_cast<std::uint16_t>(i);
+
+  const ContainerLayout& containers = native_container_layout();
+  BlobWriter out;
+  out.u32(schema_magic);
+  out.u16(schema_format_version);
+  out.u16(static_cast<std::uint16_t>(sorted.size()));
+  out.u32(0);  // total_bytes, filled in below
+  for (const std::uint8_t value :
+       {containers.pointer_size, containers.vector_size, containers.vector_begin_offset,
+        containers.vector_end_offset, containers.string_size, containers.string_data_offset,
+        containers.string_length_offset, std::uint8_t{0}}) {
+    out.u8(value);
+  }
+  for (const TypeDescriptor* type : sorted) {
+    out.u64(type->hash);
+    out.u32(type->size);
+    out.u32(type->align);
+    out.u16(static_cast<std::uint16_t>(type->fields.size()));
+    out.name(type->name);
+    for (const FieldDescriptor& field : type->fields) {
+      out.name(field.name);
+      out.u8(static_cast<std::uint8_t>(field.kind));
+      out.u8(static_cast<std::uint8_t>(field.shape));
+      out.u16(field.nested != nullptr ? index[field.nested] : schema_no_type);
+      for (const std::uint32_t value :
+           {field.offset, field.size, field.element_size, field.element_align, field.array_length,
+            field.sequence_bound, field.string_bound}) {
+        out.u32(value);
+      }
+    }
+  }
+  std::vector<std::uint8_t>& blob = out.bytes();
+  if (blob.size() > schema_max_bytes) {
+    throw SchemaError("agnocast: the schema of " + std::string(root.name) + " takes " +
+                      std::to_string(blob.size()) + " bytes, more than the " +
+                      std::to_string(schema_max_bytes) + " a topic can hold");
+  }
+  const auto total = static_cast<std::uint32_t>(blob.size());
+  for (int i = 0; i < 4; ++i) blob[8 + i] = static_cast<std::uint8_t>(total >> (8 * i));
+  return std::move(blob);
+}
+
+Schema parse_schema(std::span<const std::uint8_t> blob) {
+  if (blob.size() > schema_max_bytes) throw SchemaError("schema: larger than schema_max_bytes");
+  BlobReader in(blob);
+  if (in.u32() != schema_magic) throw SchemaError("schema: bad magic (not an agnocast schema)");
+  if (const std::uint16_t version = in.u16(); version != schema_format_version) {
+    throw SchemaError("schema: format version " + std::to_string(version) + ", this reader knows " +
+                      std::to_string(schema_format_version));
+  }
+  const std::uint16_t type_count = in.u16();
+  if (type_count == 0) throw SchemaError("schema: no type");
+  if (in.u32() != blob.size()) throw SchemaError("schema: total_bytes differs from the blob size");
+  Schema schema;
+  ContainerLayout& containers = schema.containers;
+  containers.pointer_size = in.u8();
+  containers.vector_size = in.u8();
+  containers.vector_begin_offset = in.u8();
+  containers.vector_end_offset = in.u8();
+  containers.string_size = in.u8();
+  containers.string_data_offset = in.u8();
+  containers.string_length_offset = in.u8();
+  in.u8();
+  if (containers.pointer_size != sizeof(void*) ||
+      containers.vector_begin_offset + sizeof(void*) > containers.vector_size ||
+      containers.vector_end_offset + sizeof(void*) > containers.vector_size ||
+      containers.string_data_offset + sizeof(void*) > containers.string_size ||
+      containers.string_length_offset + sizeof(std::size_t) > containers.string_size) {
+    throw SchemaError("schema: container layout unusable on this machine");
+  }
+  // Each type and field takes at least its fixed bytes: counts beyond that are lies.
+  if (static_cast<std::size_t>(type_count) * type_fixed_bytes > blob.size()) {
+    throw SchemaError("schema: truncated");
+  }
+  schema.types.resize(type_count);
+  for (SchemaType& type : schema.types) {
+    type.hash = in.u64();
+    type.size = in.u32();
+    type.align = in.u32();
+    const std::uint16_t field_count = in.u16();
+    if (static_cast<std::size_t>(field_count) * field_fixed_bytes > blob.size()) {
+      throw SchemaError("schema: truncated");
+    }
+    type.name = in.name();
+    type.fields.resize(field_count);
+    for (SchemaField& field : type.fields) {
+      field.name = in.name();
+      field.kind = static_cast<FieldKind>(in.u8());
+      field.shape = static_cast<FieldShape>(in.u8());
+      field.nested = in.u16();
+      field.offset = in.u32();
+      field.size = in.u32();
+      field.element_size = in.u32();
+      field.element_align = in.u32();
+      field.array_length = in.u32();
+      field.sequence_bound = in.u32();
+      field.string_bound = in.u32();
+    }
+  }
+  if (!in.at_end()) throw SchemaError("schema: bytes after the last type");
+  for (std::size_t i = 0; i < schema.types.size(); ++i) {
+    for (const SchemaField& field : schema.types[i].fields) check_field(schema, i, field);
+  }
+  return schema;
+}
+
+}  // namespace agnocast

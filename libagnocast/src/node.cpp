@@ -84,7 +84,7 @@ void register_subscription(NodeState& node, const std::shared_ptr<SubscriptionBa
 namespace agnocast::detail {
 
 EndpointRequest make_endpoint_request(const NodeState& node, std::string_view topic, const QoS& qos,
-                                      bool polling) {
+                                      bool polling, const MessageType& type) {
   validate_topic_name(topic);
   if (qos.depth() < 1 || qos.depth() > depth_max) {
     throw std::invalid_argument("QoS depth " + std::to_string(qos.depth()) +
@@ -97,6 +97,9 @@ EndpointRequest make_endpoint_request(const NodeState& node, std::string_view to
   request.depth = static_cast<std::uint32_t>(qos.depth());
   request.transient_local = qos.is_transient_local();
   request.polling = polling;
+  request.type_name = std::string(type.name);
+  request.type_hash = type.hash;
+  request.schema = type.schema;
   return request;
 }
 

@@ -35,8 +35,9 @@ struct PublisherCore::State {
 };
 
 PublisherCore::PublisherCore(std::shared_ptr<NodeState> node, std::string_view topic,
-                             const QoS& qos) {
-  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/false);
+                             const QoS& qos, const MessageType& type) {
+  const EndpointRequest request =
+      make_endpoint_request(*node, topic, qos, /*polling=*/false, type);
   state_ = std::make_unique<State>(std::move(node), Runtime::get(), request);
 }
 

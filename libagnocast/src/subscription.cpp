@@ -83,9 +83,10 @@ struct SubscriptionBase::State {
 };
 
 SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic,
-                                   const QoS& qos)
+                                   const QoS& qos, const MessageType& type)
     : state_(std::make_unique<State>()) {
-  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/false);
+  const EndpointRequest request =
+      make_endpoint_request(*node, topic, qos, /*polling=*/false, type);
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
@@ -155,9 +156,10 @@ struct PollingCore::State {
   std::shared_ptr<SubscriberEndpoint> endpoint;
 };
 
-PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos)
+PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
+                         const MessageType& type)
     : state_(std::make_unique<State>()) {
-  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/true);
+  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/true, type);
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);

@@ -734,5 +734,67 @@ TEST(Access, APolicyRefusalNamesTheTopicAndTheFix) {
   EXPECT_EQ(agnocast::access_policy(), std::nullopt);
 }
 
+// A hand-declared message with the same field names as chatter's but another
+// layout: it must never be read as one.
+struct LookAlike {
+  std::uint32_t seq = 0;
+  std::uint64_t checksum = 0;
+  agnocast::vector<std::uint8_t> payload;
+};
+
+}  // namespace
+}  // namespace e2e
+
+AGNOCAST_MESSAGE(e2e::LookAlike, "chatter/msg/Message", seq, checksum, payload);
+
+namespace e2e {
+namespace {
+
+TEST(Types, AnEndpointOfAnotherTypeIsRefusedNamingBoth) {
+  const std::string topic = unique_topic("typed");
+  agnocast::Node node{"typed"};
+  auto publisher = node.create_publisher<Message>(topic, QoS{1});
+  const auto info = agnocast::topic_info(topic);
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->type_name, agnocast::message_traits<Message>::type_name);
+  EXPECT_EQ(info->type_hash, agnocast::message_traits<Message>::type_hash);
+  const auto schema = agnocast::topic_schema(topic);
+  ASSERT_TRUE(schema);
+  const auto expected = agnocast::schema_of<Message>();
+  EXPECT_TRUE(std::equal(schema->begin(), schema->end(), expected.begin(), expected.end()));
+
+  // Same name, other layout: refused in another process and in this one.
+  const int status = wait_child(fork_child([&] {
+    agnocast::Node other{"other"};
+    try {
+      auto subscription = other.create_subscription<LookAlike>(
+          topic, QoS{1}, [](const agnocast::ipc_shared_ptr<const LookAlike>&) {});
+      return 2;
+    } catch (const agnocast::TypeMismatch& error) {
+      const std::string what = error.what();
+      return what.find(topic) != std::string::npos &&
+                     what.find("chatter/msg/Message") != std::string::npos
+                 ? 0
+                 : 3;
+    }
+  }));
+  EXPECT_TRUE(exited_ok(status)) << status;
+  try {
+    auto poller = node.create_polling_subscriber<std::uint64_t>(topic, QoS{1});
+    ADD_FAILURE() << "a raw:8:8 subscriber joined a chatter/msg/Message topic";
+  } catch (const agnocast::TypeMismatch& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("raw:8:8"), std::string::npos) << what;
+    EXPECT_NE(what.find("chatter/msg/Message"), std::string::npos) << what;
+  }
+  // The refusals left the topic as it was, and the right type still joins.
+  EXPECT_EQ(agnocast::topic_info(topic)->subscribers.size(), 0U);
+  auto poller = node.create_polling_subscriber<Message>(topic, QoS{1});
+  publish(*publisher, 7, 128);
+  auto message = poller->take_data();
+  ASSERT_TRUE(message);
+  EXPECT_TRUE(chatter::verify(*message));
+}
+
 }  // namespace
 }  // namespace e2e

@@ -20,7 +20,7 @@ class Publisher {
 
  public:
   Publisher(std::shared_ptr<detail::NodeState> node, std::string_view topic, const QoS& qos)
-      : core_(std::move(node), topic, qos) {}
+      : core_(std::move(node), topic, qos, detail::message_type_of<T>()) {}
 
   // A default-constructed T in this process's shared pool, for you to fill in.
   ipc_shared_ptr<T> borrow_loaned_message() {

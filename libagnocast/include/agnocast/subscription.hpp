@@ -17,7 +17,8 @@ class Subscription : public detail::SubscriptionBase {
 
   Subscription(std::shared_ptr<detail::NodeState> node, std::string_view topic, const QoS& qos,
                Callback callback)
-      : SubscriptionBase(std::move(node), topic, qos), callback_(std::move(callback)) {}
+      : SubscriptionBase(std::move(node), topic, qos, detail::message_type_of<T>()),
+        callback_(std::move(callback)) {}
 
   const std::string& get_topic_name() const { return topic(); }
 
@@ -35,7 +36,7 @@ template <class T>
 class PollingSubscriber {
  public:
   PollingSubscriber(std::shared_ptr<detail::NodeState> node, std::string_view topic, const QoS& qos)
-      : core_(std::move(node), topic, qos) {}
+      : core_(std::move(node), topic, qos, detail::message_type_of<T>()) {}
 
   // The newest message not taken yet; empty when nothing new arrived.
   ipc_shared_ptr<const T> take_data() {

@@ -5,19 +5,36 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
 #include "agnocast/detail/message.hpp"
+#include "agnocast/message_traits.hpp"
 #include "agnocast/qos.hpp"
+#include "agnocast/schema.hpp"
 
 namespace agnocast::detail {
 
 struct NodeState;  // the node's name and its subscriptions, for executors
 
+// What an endpoint tells the kernel about its message type: a topic carries
+// one type, and tools decode its messages from the schema.
+struct MessageType {
+  std::string_view name;
+  std::uint64_t hash = 0;
+  std::span<const std::uint8_t> schema;
+};
+
+template <Publishable T>
+MessageType message_type_of() {
+  return MessageType{message_traits<T>::type_name, message_traits<T>::type_hash, schema_of<T>()};
+}
+
 class PublisherCore {
  public:
-  PublisherCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos);
+  PublisherCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
+                const MessageType& type);
   ~PublisherCore();
   PublisherCore(const PublisherCore&) = delete;
   PublisherCore& operator=(const PublisherCore&) = delete;
@@ -40,7 +57,8 @@ struct TakenEntry {
 
 class PollingCore {
  public:
-  PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos);
+  PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
+              const MessageType& type);
   ~PollingCore();
   PollingCore(const PollingCore&) = delete;
   PollingCore& operator=(const PollingCore&) = delete;
@@ -72,7 +90,8 @@ class SubscriptionBase {
   std::size_t handle_wakeup();
 
  protected:
-  SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos);
+  SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
+                   const MessageType& type);
   // Must take ownership of reference (count one) even when it throws.
   virtual void deliver(const void* message, EntryReference* reference) = 0;
 

@@ -46,7 +46,10 @@ std::string cell(const nlohmann::json& value) {
   if (value.is_array()) {
     if (value.empty()) return "-";
     std::string joined;
-    for (const auto& item : value) joined += (joined.empty() ? "" : ",") + cell(item);
+    for (const auto& item : value) {
+      if (!joined.empty()) joined += ',';
+      joined += cell(item);
+    }
     return joined;
   }
   return value.dump();

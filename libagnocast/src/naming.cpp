@@ -61,7 +61,8 @@ std::optional<QueueNameParts> parse_queue_name(std::string_view name) {
   const auto [end, error] =
       std::from_chars(digits.data(), digits.data() + digits.size(), parts.subscriber_id);
   if (error != std::errc{} || end != digits.data() + digits.size()) return std::nullopt;
-  parts.mangled_topic = "/" + std::string(name.substr(0, at));
+  parts.mangled_topic = '/';
+  parts.mangled_topic += name.substr(0, at);
   // A mangled topic is a valid topic without inner '/'.
   if (parts.mangled_topic.find('/', 1) != std::string::npos ||
       !is_valid_topic_name(parts.mangled_topic)) {

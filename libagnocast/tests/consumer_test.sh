@@ -19,9 +19,10 @@ LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/consumer" | grep -q '^agnocast '
 pcdir=$(dirname "$(find "$prefix" -name agnocast.pc | head -n1)")
 export PKG_CONFIG_PATH=$pcdir
 test "$(pkg-config --modversion agnocast)" = "$(LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/consumer" | cut -d' ' -f2)"
+# Exactly what pkg-config prints, the C++ standard included, plus the
+# consumer's own message headers (generated for the CMake build above).
 # shellcheck disable=SC2046 # pkg-config output is meant to be split
-# (its own message headers are the ones agnocast-msggen generated for the CMake build)
-c++ -std=c++20 -o "$scratch/consumer-pc" "$source/main.cpp" \
+c++ -o "$scratch/consumer-pc" "$source/main.cpp" \
   -I"$scratch/cmake-build/agnocast_messages/consumer_msgs" $(pkg-config --cflags --libs agnocast)
 LD_LIBRARY_PATH=$libdir "$scratch/consumer-pc" | grep -q '^agnocast '
 echo "consumer builds with find_package and pkg-config"

@@ -112,12 +112,14 @@ int run(const agnocastd::Config& config, std::function<agnocastd::Config()> rere
   // Queues are listed and limited through the mqueue filesystem and sysctls.
   agnocastd::ensure_mqueue_mounted();
   agnocastd::apply_mqueue_limits(config.mqueue);
-  // Before READY=1: no client may create an endpoint the policy would refuse.
-  agnocastd::apply_access_policy(config.access);
   // unload_on_exit as the configuration in force at stop says.
   bool unload_on_exit = config.unload_on_exit;
   {
     agnocast::ExitRecordReader exit_records;
+    // Before READY=1: no client may create an endpoint the policy would
+    // refuse. Set while exit_records is open, whose descriptor keeps the
+    // namespace's kernel state (and so the policy) alive.
+    agnocastd::apply_access_policy(config.access);
     agnocastd::SystemHost host;
     agnocastd::Supervisor supervisor{config,
                                      std::move(reread_config),

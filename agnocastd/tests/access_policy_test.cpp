@@ -191,8 +191,10 @@ TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
       spawn(&safety_member,
             {"agnocast-talker", "--topic", "/safety/brake", "--rate", "100", "--linger", "0"},
             "talker.log");
-  const pid_t listener =
-      spawn(&outsider, {"agnocast-listener", "--topic", "/safety/brake", "--json"}, "listener.log");
+  // The same user as the talker: wake-ups go through the listener's queue,
+  // which the umask may keep other users from writing.
+  const pid_t listener = spawn(
+      &safety_member, {"agnocast-listener", "--topic", "/safety/brake", "--json"}, "listener.log");
   const auto published = [] {
     const json info = cli_json(nullptr, {"topic", "info", "/safety/brake"});
     return info.is_object() && !info["publishers"].empty()

@@ -59,6 +59,7 @@ int run_cli(int argc, const char* const* argv, InspectionSource& source, std::os
   set_node_command(app, context);
   set_daemon_command(app, context);
   set_doctor_command(app, context);
+  set_policy_command(app, context);
   set_version_command(app, context);
 
   try {

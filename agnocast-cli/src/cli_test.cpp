@@ -52,6 +52,7 @@ TEST(Cli, EveryCommandRunsOnAHealthySystem) {
                                                           {"node", "list"},
                                                           {"daemon", "status"},
                                                           {"doctor"},
+                                                          {"policy", "show"},
                                                           {"version"}};
   for (const auto& command : commands) {
     for (bool json : {false, true}) {

@@ -41,6 +41,12 @@ void set_doctor_command(CLI::App& app, Context& context);
 nlohmann::json doctor_json(InspectionSource& source, const std::string& daemon_status_path);
 std::string doctor_table(const nlohmann::json& value);
 
+void set_policy_command(CLI::App& app, Context& context);
+// {"policy": null} without a policy; principals by name ("group:safety"),
+// or by id when the system has no name for it ("user:1234").
+nlohmann::json policy_show_json(InspectionSource& source);
+std::string policy_show_table(const nlohmann::json& value);
+
 void set_version_command(CLI::App& app, Context& context);
 nlohmann::json version_json(InspectionSource& source);
 std::string version_table(const nlohmann::json& value);

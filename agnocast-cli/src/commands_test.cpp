@@ -313,5 +313,59 @@ TEST(Version, ModuleIsNullWhenNotLoaded) {
   EXPECT_EQ(keys_of(value), (std::vector<std::string>{"cli", "library", "module"}));
 }
 
+FakeSource policy_system() {
+  using Kind = AccessPrincipal::Kind;
+  FakeSource source = healthy_system();
+  source.users = {{0, "root"}, {1000, "monitor"}};
+  source.groups = {{990, "agnocast"}, {991, "safety"}};
+  source.policy = AccessPolicy{
+      true,
+      {{"/safety/**", std::vector<AccessPrincipal>{{Kind::group, 991}},
+        std::vector<AccessPrincipal>{{Kind::group, 990}, {Kind::user, 1000}}},
+       {"/private/*", std::vector<AccessPrincipal>{{Kind::user, 1234}, {Kind::group, 4321}},
+        std::vector<AccessPrincipal>{}},
+       {"/open", std::nullopt, std::vector<AccessPrincipal>{{Kind::anyone, 0}}}}};
+  return source;
+}
+
+TEST(PolicyShow, NullWithoutAPolicy) {
+  FakeSource source = healthy_system();
+  EXPECT_EQ(policy_show_json(source), json::parse(R"({"policy": null})"));
+  EXPECT_EQ(policy_show_table(policy_show_json(source)),
+            "no topic access policy: anyone with access to /dev/agnocast may publish and "
+            "subscribe\n");
+}
+
+TEST(PolicyShow, RulesInOrderWithNamesOrIdsAndNullForUnlistedDirections) {
+  FakeSource source = policy_system();
+  EXPECT_EQ(policy_show_json(source), json::parse(R"({"policy": {"default": "allow", "rules": [
+    {"topics": "/safety/**", "publish": ["group:safety"],
+     "subscribe": ["group:agnocast", "user:monitor"]},
+    {"topics": "/private/*", "publish": ["user:1234", "group:4321"], "subscribe": []},
+    {"topics": "/open", "publish": null, "subscribe": ["*"]}]}})"));
+}
+
+TEST(PolicyShow, TableGoldenText) {
+  FakeSource source = policy_system();
+  EXPECT_EQ(policy_show_table(policy_show_json(source)),
+            "default: allow (topics no rule matches, and directions a rule leaves open)\n"
+            "TOPICS      PUBLISH               SUBSCRIBE\n"
+            "/safety/**  group:safety          group:agnocast,user:monitor\n"
+            "/private/*  user:1234,group:4321  (nobody)\n"
+            "/open       (default)             *\n");
+  source.policy = AccessPolicy{false, {}};
+  EXPECT_EQ(policy_show_json(source),
+            json::parse(R"({"policy": {"default": "deny", "rules": []}})"));
+  EXPECT_EQ(policy_show_table(policy_show_json(source)),
+            "default: deny (topics no rule matches, and directions a rule leaves open)\n"
+            "no rules\n");
+}
+
+TEST(PolicyShow, ModuleAbsentThrowsModuleNotLoaded) {
+  FakeSource source;
+  source.loaded = false;
+  EXPECT_THROW(policy_show_json(source), ModuleNotLoaded);
+}
+
 }  // namespace
 }  // namespace agnocast::cli

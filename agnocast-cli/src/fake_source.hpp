@@ -15,6 +15,9 @@ class FakeSource : public InspectionSource {
   bool loaded = true;
   Version version = library_version;
   std::vector<TopicInfo> topics;
+  std::optional<AccessPolicy> policy;
+  std::map<std::uint32_t, std::string> users;     // uid -> name
+  std::map<std::uint32_t, std::string> groups;    // gid -> name
   std::map<std::string, QueueAttributes> queues;  // by queue name ("/chatter@1")
   std::set<std::string> unreadable_queues;        // exist, but mq_open is refused
   std::set<std::string> paths;                    // that exist
@@ -47,6 +50,12 @@ class FakeSource : public InspectionSource {
     }
     return std::nullopt;
   }
+  std::optional<AccessPolicy> access_policy() override {
+    require_module();
+    return policy;
+  }
+  std::optional<std::string> user_name(std::uint32_t uid) override { return name_of(users, uid); }
+  std::optional<std::string> group_name(std::uint32_t gid) override { return name_of(groups, gid); }
   std::vector<std::string> queue_files() override {
     std::vector<std::string> names;
     for (const auto& [name, attributes] : queues) names.push_back(name.substr(1));
@@ -81,6 +90,11 @@ class FakeSource : public InspectionSource {
  private:
   void require_module() const {
     if (!loaded) throw ModuleNotLoaded();
+  }
+  static std::optional<std::string> name_of(const std::map<std::uint32_t, std::string>& names,
+                                            std::uint32_t id) {
+    const auto it = names.find(id);
+    return it == names.end() ? std::nullopt : std::optional(it->second);
   }
 };
 

@@ -4,10 +4,12 @@
 
 #include <sys/types.h>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "agnocast/access_policy.hpp"
 #include "agnocast/inspect.hpp"
 #include "agnocast/version.hpp"
 
@@ -29,6 +31,12 @@ class InspectionSource {
   // These throw agnocast::ModuleNotLoaded when the module is absent.
   virtual std::vector<TopicSummary> list_topics() = 0;
   virtual std::optional<TopicInfo> topic_info(const std::string& topic) = 0;
+  // The topic access policy in force; nullopt when there is none.
+  virtual std::optional<AccessPolicy> access_policy() = 0;
+
+  // Names from the passwd and group databases; nullopt when an id has none.
+  virtual std::optional<std::string> user_name(std::uint32_t uid) = 0;
+  virtual std::optional<std::string> group_name(std::uint32_t gid) = 0;
 
   // File names (without the leading '/') of every queue in the mqueue directory.
   virtual std::vector<std::string> queue_files() = 0;

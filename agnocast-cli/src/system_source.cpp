@@ -1,5 +1,7 @@
 #include <fcntl.h>
+#include <grp.h>
 #include <mqueue.h>
+#include <pwd.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -10,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "agnocast/errors.hpp"
 #include "agnocast/inspect.hpp"
@@ -31,6 +34,24 @@ std::optional<Version> sysfs_module_version() {
   return std::nullopt;
 }
 
+// getpwuid_r/getgrgid_r with a buffer that grows on ERANGE; nullopt when the
+// database has no entry (or cannot be read: the id is shown instead).
+template <typename Entry, typename Lookup, typename NameOf>
+std::optional<std::string> name_of_id(std::uint32_t id, Lookup lookup, NameOf name_of) {
+  std::vector<char> buffer(1024);
+  for (;;) {
+    Entry entry{};
+    Entry* found = nullptr;
+    const int error = lookup(id, &entry, buffer.data(), buffer.size(), &found);
+    if (error == ERANGE && buffer.size() < (1u << 20)) {
+      buffer.resize(buffer.size() * 2);
+      continue;
+    }
+    if (found == nullptr) return std::nullopt;
+    return std::string(name_of(*found));
+  }
+}
+
 class SystemSource final : public InspectionSource {
  public:
   std::optional<Version> module_version() override {
@@ -45,6 +66,14 @@ class SystemSource final : public InspectionSource {
   std::vector<TopicSummary> list_topics() override { return agnocast::list_topics(); }
   std::optional<TopicInfo> topic_info(const std::string& topic) override {
     return agnocast::topic_info(topic);
+  }
+
+  std::optional<AccessPolicy> access_policy() override { return agnocast::access_policy(); }
+  std::optional<std::string> user_name(std::uint32_t uid) override {
+    return name_of_id<passwd>(uid, ::getpwuid_r, [](const passwd& p) { return p.pw_name; });
+  }
+  std::optional<std::string> group_name(std::uint32_t gid) override {
+    return name_of_id<group>(gid, ::getgrgid_r, [](const group& g) { return g.gr_name; });
   }
 
   std::vector<std::string> queue_files() override {

@@ -4,6 +4,7 @@
 
 #include <sys/types.h>
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -32,14 +33,23 @@ struct DeadProcess {
 class DeadProcessCollector {
  public:
   std::vector<DeadProcess> add(const std::vector<agnocast::ExitRecord>& records);
+  // How many records the kernel discarded unread since the last call.
+  std::uint64_t take_lost();
 
  private:
   std::map<pid_t, std::vector<std::string>> pending_queues_;
+  std::uint64_t lost_ = 0;
 };
 
 // Removes what one dead process left, always in this order: its queues (no
 // publisher can wake a dead subscriber any more), then its pool object, then
 // it is counted.
 void clean_dead_process(const DeadProcess& process, Host& host, Counters& counters);
+
+// Cleans up after the processes these records complete; when the kernel
+// discarded records unread, also sweeps at once, since only a sweep finds what
+// the lost ones named. True when anything was cleaned or swept.
+bool handle_exit_records(const std::vector<agnocast::ExitRecord>& records,
+                         DeadProcessCollector& collector, Host& host, Counters& counters);
 
 }  // namespace agnocastd

@@ -16,6 +16,7 @@ ExitRecord queue_record(pid_t pid, std::string topic, std::uint32_t id) {
   return {ExitRecord::Kind::queue, pid, std::move(topic), id};
 }
 ExitRecord process_record(pid_t pid) { return {ExitRecord::Kind::process, pid, {}, 0}; }
+ExitRecord lost_record(std::uint32_t count) { return {ExitRecord::Kind::lost, 0, {}, 0, count}; }
 
 TEST(PoolObjectName, RoundTrips) {
   EXPECT_EQ(pool_object_name(1234), "agnocast@1234");
@@ -64,6 +65,50 @@ TEST(CleanDeadProcess, LeavesThePoolObjectOfARecycledPid) {
   EXPECT_EQ(host.shm.size(), 1u);
   EXPECT_EQ(counters.shm_removed, 0u);
   EXPECT_EQ(counters.processes_cleaned, 1u);
+}
+
+TEST(HandleExitRecords, CleansCompletedProcessesWithoutSweeping) {
+  FakeHost host;
+  host.queues = {"a@1", "stale@9"};
+  DeadProcessCollector collector;
+  Counters counters;
+  EXPECT_FALSE(handle_exit_records({queue_record(10, "/a", 1)}, collector, host, counters));
+  EXPECT_TRUE(handle_exit_records({process_record(10)}, collector, host, counters));
+  EXPECT_THAT(host.calls, ElementsAre("remove_queue /a@1", "remove_shm agnocast@10"));
+  EXPECT_EQ(host.queues, std::set<std::string>{"stale@9"});  // left for the periodic sweep
+}
+
+TEST(HandleExitRecords, LostRecordsSweepAtOnce) {
+  FakeHost host;
+  // Queues of processes whose records were discarded, and a live one.
+  host.queues = {"a@1", "b@2", "live@3"};
+  host.live = {"/live@3"};
+  host.shm = {"agnocast@20"};
+  DeadProcessCollector collector;
+  Counters counters;
+  EXPECT_FALSE(handle_exit_records({queue_record(10, "/a", 1)}, collector, host, counters));
+  EXPECT_TRUE(handle_exit_records({lost_record(7), process_record(11)}, collector, host, counters));
+  EXPECT_EQ(host.queues, std::set<std::string>{"live@3"});
+  EXPECT_TRUE(host.shm.empty());
+  EXPECT_EQ(counters.processes_cleaned, 1u);  // 11; 10's process record was lost
+  EXPECT_EQ(counters.queues_removed, 2u);
+  EXPECT_EQ(counters.shm_removed, 1u);
+  // The sweep came after the cleanup of process 11.
+  ASSERT_FALSE(host.calls.empty());
+  EXPECT_EQ(host.calls.front(), "remove_shm agnocast@11");
+  EXPECT_EQ(collector.take_lost(), 0u);
+  // A process record arriving after the loss no longer carries 10's queues.
+  const auto later = collector.add({process_record(10)});
+  ASSERT_EQ(later.size(), 1u);
+  EXPECT_THAT(later[0].queues, IsEmpty());
+}
+
+TEST(DeadProcessCollector, CountsLostRecordsUntilTaken) {
+  DeadProcessCollector collector;
+  EXPECT_THAT(collector.add({lost_record(3)}), IsEmpty());
+  EXPECT_THAT(collector.add({lost_record(4)}), IsEmpty());
+  EXPECT_EQ(collector.take_lost(), 7u);
+  EXPECT_EQ(collector.take_lost(), 0u);
 }
 
 }  // namespace

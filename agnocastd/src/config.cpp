@@ -7,6 +7,10 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "access_principal.hpp"
 
 namespace agnocastd {
 namespace {
@@ -77,6 +81,72 @@ void read_object(const json& object, std::string_view where,
     if (handler == handlers.end()) fail(key, "unknown key");
     handler->second(value, key);
   }
+}
+
+std::string element_key(std::string_view key, std::size_t index) {
+  return std::string(key) + "[" + std::to_string(index) + "]";
+}
+
+std::vector<agnocast::AccessPrincipal> access_principals(const json& value, std::string_view key) {
+  if (!value.is_array()) {
+    fail(key, "expected an array of \"user:NAME\", \"group:NAME\" or \"*\", got " + type_of(value));
+  }
+  std::vector<agnocast::AccessPrincipal> principals;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string element = element_key(key, i);
+    try {
+      principals.push_back(parse_access_principal(text(value[i], element)));
+    } catch (const std::invalid_argument& error) {
+      fail(element, error.what());
+    }
+  }
+  return principals;
+}
+
+agnocast::AccessRule access_rule(const json& value, std::string_view key) {
+  agnocast::AccessRule rule;
+  bool has_topics = false;
+  read_object(
+      value, key,
+      {
+          {"topics",
+           [&](const json& v, auto k) {
+             rule.topics = text(v, k);
+             try {
+               agnocast::parse_topic_pattern(rule.topics);
+             } catch (const std::invalid_argument& error) {
+               fail(k, error.what());
+             }
+             has_topics = true;
+           }},
+          {"publish", [&](const json& v, auto k) { rule.publish = access_principals(v, k); }},
+          {"subscribe", [&](const json& v, auto k) { rule.subscribe = access_principals(v, k); }},
+      });
+  if (!has_topics) fail(key, "a rule needs \"topics\", the topic pattern it covers");
+  return rule;
+}
+
+agnocast::AccessPolicy access_policy(const json& value, std::string_view key) {
+  agnocast::AccessPolicy policy;
+  read_object(value, key,
+              {
+                  {"default",
+                   [&](const json& v, auto k) {
+                     const std::string decision = text(v, k);
+                     if (decision != "allow" && decision != "deny") {
+                       fail(k, "expected \"allow\" or \"deny\", got \"" + decision + "\"");
+                     }
+                     policy.default_allow = decision == "allow";
+                   }},
+                  {"rules",
+                   [&](const json& v, auto k) {
+                     if (!v.is_array()) fail(k, "expected an array of rules, got " + type_of(v));
+                     for (std::size_t i = 0; i < v.size(); ++i) {
+                       policy.rules.push_back(access_rule(v[i], element_key(k, i)));
+                     }
+                   }},
+              });
+  return policy;
 }
 
 }  // namespace
@@ -160,6 +230,7 @@ Config parse_config(std::string_view json_text) {
                fail(key, "expected one of trace, debug, info, warn, error, critical, off");
              }
            }},
+          {"access", [&](const json& v, auto key) { config.access = access_policy(v, key); }},
       });
   return config;
 }

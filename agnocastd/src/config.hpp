@@ -11,6 +11,8 @@
 #include <string>
 #include <string_view>
 
+#include "agnocast/access_policy.hpp"
+
 namespace agnocastd {
 
 inline constexpr std::string_view default_config_path = "/etc/agnocast/agnocastd.json";
@@ -29,16 +31,25 @@ struct Config {
     std::optional<long> msg_max;
     std::optional<long> queues_max;
     std::optional<long> msgsize_max;
+
+    bool operator==(const Mqueue&) const = default;
   } mqueue;
   // Applied to /dev/agnocast when set.
   struct Device {
     std::optional<std::string> group;
     std::optional<mode_t> mode;
+
+    bool operator==(const Device&) const = default;
   } device;
   std::chrono::milliseconds sweep_interval{std::chrono::seconds(5)};
   // How long to wait for /dev/agnocast after loading the module.
   std::chrono::milliseconds device_timeout{std::chrono::seconds(5)};
   std::string log_level = "info";
+  // The topic access policy loaded into the kernel; nullopt: none (anyone
+  // with access to the device may publish and subscribe).
+  std::optional<agnocast::AccessPolicy> access;
+
+  bool operator==(const Config&) const = default;
 };
 
 class ConfigError : public std::runtime_error {

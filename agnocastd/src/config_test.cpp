@@ -81,6 +81,73 @@ TEST(Config, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("{").rfind("not valid JSON: ", 0), 0u);
 }
 
+TEST(ConfigAccess, AbsentMeansNoPolicy) { EXPECT_FALSE(parse_config("{}").access); }
+
+TEST(ConfigAccess, ReadsRulesWithNamesAndIdsResolved) {
+  // root (uid 0, group 0) exists on every system the tests run on.
+  const Config config = parse_config(R"({"access": {
+    "default": "deny",
+    "rules": [
+      {"topics": "/safety/**", "publish": ["group:root", "user:1234"],
+       "subscribe": ["user:root", "group:4321", "*"]},
+      {"topics": "/public/*", "subscribe": []},
+      {"topics": "/exact"}
+    ]}})");
+  using agnocast::AccessPrincipal;
+  using Kind = AccessPrincipal::Kind;
+  ASSERT_TRUE(config.access);
+  EXPECT_FALSE(config.access->default_allow);
+  ASSERT_EQ(config.access->rules.size(), 3u);
+  const auto& safety = config.access->rules[0];
+  EXPECT_EQ(safety.topics, "/safety/**");
+  EXPECT_EQ(safety.publish, (std::vector<AccessPrincipal>{{Kind::group, 0}, {Kind::user, 1234}}));
+  EXPECT_EQ(safety.subscribe, (std::vector<AccessPrincipal>{
+                                  {Kind::user, 0}, {Kind::group, 4321}, {Kind::anyone, 0}}));
+  EXPECT_FALSE(config.access->rules[1].publish);
+  EXPECT_EQ(config.access->rules[1].subscribe, std::vector<AccessPrincipal>{});
+  EXPECT_FALSE(config.access->rules[2].publish);
+  EXPECT_FALSE(config.access->rules[2].subscribe);
+  EXPECT_TRUE(parse_config(R"({"access": {}})").access->default_allow);
+}
+
+TEST(ConfigAccess, ErrorsNameTheKeyPath) {
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["group:root",
+                                               "group:no_such_group_x"]}]}})"),
+            "config key 'access.rules[0].publish[1]': no group named 'no_such_group_x'");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a"},
+                                              {"topics": "/b", "subscribe": ["user:no_such_user_x"]}]}})"),
+            "config key 'access.rules[1].subscribe[0]': no user named 'no_such_user_x'");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["root"]}]}})"),
+            "config key 'access.rules[0].publish[0]': expected \"user:NAME\", \"group:NAME\" "
+            "(or a numeric id) or \"*\", got \"root\"");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["team:x"]}]}})"),
+            "config key 'access.rules[0].publish[0]': expected \"user:NAME\", \"group:NAME\" "
+            "(or a numeric id) or \"*\", got \"team:x\"");
+  EXPECT_EQ(
+      error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["user:4294967295"]}]}})"),
+      "config key 'access.rules[0].publish[0]': id 4294967295 is out of range");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": "group:root"}]}})"),
+            "config key 'access.rules[0].publish': expected an array of \"user:NAME\", "
+            "\"group:NAME\" or \"*\", got string");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": [0]}]}})"),
+            "config key 'access.rules[0].publish[0]': expected a string, got number");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"publish": []}]}})"),
+            "config key 'access.rules[0]': a rule needs \"topics\", the topic pattern it covers");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "read": []}]}})"),
+            "config key 'access.rules[0].read': unknown key");
+  EXPECT_EQ(error_of(R"({"access": {"default": "maybe"}})"),
+            "config key 'access.default': expected \"allow\" or \"deny\", got \"maybe\"");
+  EXPECT_EQ(error_of(R"({"access": {"rules": {}}})"),
+            "config key 'access.rules': expected an array of rules, got object");
+  EXPECT_EQ(error_of(R"({"access": {"rule": []}})"), "config key 'access.rule': unknown key");
+  EXPECT_EQ(error_of(R"({"access": []})"), "config key 'access': expected an object");
+  const std::string bad_pattern = error_of(R"({"access": {"rules": [{"topics": "/a/**/b"}]}})");
+  EXPECT_EQ(
+      bad_pattern.rfind("config key 'access.rules[0].topics': access rule topics '/a/**/b'", 0), 0u)
+      << bad_pattern;
+  EXPECT_NE(error_of(R"({"access": {"rules": [{"topics": "safety/**"}]}})"), "");
+}
+
 TEST(Config, MissingFileIsDefaultOnlyForTheDefaultPath) {
   const std::string path = ::testing::TempDir() + "/agnocastd-missing.json";
   std::remove(path.c_str());

@@ -15,6 +15,7 @@
 #include "errno_error.hpp"
 #include "module_loader.hpp"
 #include "notify.hpp"
+#include "reload.hpp"
 #include "status_file.hpp"
 #include "sweeper.hpp"
 
@@ -46,17 +47,20 @@ class Fd {
   int fd_;
 };
 
+// (Re)starts a timer to fire every period from now.
+void arm_timer(int fd, std::chrono::microseconds period) {
+  itimerspec spec{};
+  spec.it_interval.tv_sec = period.count() / 1'000'000;
+  spec.it_interval.tv_nsec = (period.count() % 1'000'000) * 1000;
+  spec.it_value = spec.it_interval;
+  if (::timerfd_settime(fd, 0, &spec, nullptr) != 0) throw_errno("timerfd_settime");
+}
+
 // A periodic timer, or a descriptor that never fires when period is zero.
 int periodic_timer(std::chrono::microseconds period) {
   const int fd = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
   if (fd < 0) throw_errno("timerfd_create");
-  if (period.count() > 0) {
-    itimerspec spec{};
-    spec.it_interval.tv_sec = period.count() / 1'000'000;
-    spec.it_interval.tv_nsec = (period.count() % 1'000'000) * 1000;
-    spec.it_value = spec.it_interval;
-    if (::timerfd_settime(fd, 0, &spec, nullptr) != 0) throw_errno("timerfd_settime");
-  }
+  if (period.count() > 0) arm_timer(fd, period);
   return fd;
 }
 
@@ -81,12 +85,27 @@ void clean_exited_processes(Supervisor& supervisor) {
   bool cleaned = false;
   for (auto records = supervisor.exit_records.read_available(); !records.empty();
        records = supervisor.exit_records.read_available()) {
-    for (const auto& process : supervisor.collector.add(records)) {
-      clean_dead_process(process, supervisor.host, supervisor.counters);
-      cleaned = true;
-    }
+    cleaned |=
+        handle_exit_records(records, supervisor.collector, supervisor.host, supervisor.counters);
   }
   if (cleaned) write_status(supervisor, /*running=*/true);
+}
+
+bool reload_config(Supervisor& supervisor) {
+  Config next;
+  try {
+    next = supervisor.reread_config();
+    apply_runtime_config(supervisor.config, next);
+  } catch (const std::exception& error) {
+    spdlog::error("configuration not reloaded, the one in force stays: {}", error.what());
+    return false;
+  }
+  for (const std::string& difference : restart_only_differences(supervisor.config, next)) {
+    spdlog::warn("{}", difference);
+  }
+  supervisor.config = std::move(next);
+  spdlog::info("configuration reloaded");
+  return true;
 }
 
 void write_status(const Supervisor& supervisor, bool running) {
@@ -152,7 +171,12 @@ void serve(Supervisor& supervisor) {
           spdlog::info("received {}, stopping", strsignal(static_cast<int>(info.ssi_signo)));
           return;
         }
-        spdlog::info("received SIGHUP, sweeping now");
+        spdlog::info("received SIGHUP, reloading the configuration");
+        const auto sweep_interval = supervisor.config.sweep_interval;
+        if (reload_config(supervisor) && supervisor.config.sweep_interval != sweep_interval) {
+          arm_timer(sweep_timer.get(), supervisor.config.sweep_interval);
+          spdlog::info("sweeping every {} ms", supervisor.config.sweep_interval.count());
+        }
         sweep_now(supervisor);
       }
     }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -17,15 +18,19 @@ namespace agnocastd {
 
 // What the daemon knows while it serves.
 struct Supervisor {
-  Supervisor(const Config& config, Host& host, agnocast::ExitRecordReader& exit_records,
-             std::string status_path, std::string module_version)
-      : config(config),
+  Supervisor(Config config, std::function<Config()> reread_config, Host& host,
+             agnocast::ExitRecordReader& exit_records, std::string status_path,
+             std::string module_version)
+      : config(std::move(config)),
+        reread_config(std::move(reread_config)),
         host(host),
         exit_records(exit_records),
         status_path(std::move(status_path)),
         module_version(std::move(module_version)) {}
 
-  const Config& config;
+  Config config;  // the one in force; SIGHUP replaces it
+  // Reads the configuration file again; throws ConfigError.
+  std::function<Config()> reread_config;
   Host& host;
   agnocast::ExitRecordReader& exit_records;
   std::string status_path;
@@ -40,8 +45,14 @@ struct Supervisor {
 // even while the daemon is still starting.
 void block_daemon_signals();
 
-// Cleans up after every process whose exit records wait now.
+// Cleans up after every process whose exit records wait now; sweeps when
+// the kernel discarded records unread.
 void clean_exited_processes(Supervisor& supervisor);
+
+// Re-reads the configuration and applies it (see reload.hpp); a bad file or a
+// failure to apply it is logged and the configuration in force stays. True
+// when the new configuration is in force.
+bool reload_config(Supervisor& supervisor);
 
 // Rewrites the status file; logs (does not throw) when it cannot.
 void write_status(const Supervisor& supervisor, bool running);
@@ -49,8 +60,8 @@ void write_status(const Supervisor& supervisor, bool running);
 // True when /dev/agnocast is there and answers with a compatible version.
 bool module_healthy();
 
-// Serves until SIGTERM or SIGINT (SIGHUP sweeps at once). Throws on a broken
-// descriptor.
+// Serves until SIGTERM or SIGINT; SIGHUP reloads the configuration, then
+// sweeps. Throws on a broken descriptor.
 void serve(Supervisor& supervisor);
 
 }  // namespace agnocastd

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdlib>
 #include <exception>
+#include <functional>
 #include <optional>
 
 #include "agnocast/inspect.hpp"
@@ -18,6 +19,7 @@
 #include "module_loader.hpp"
 #include "mqueue_setup.hpp"
 #include "notify.hpp"
+#include "reload.hpp"
 #include "sweeper.hpp"
 
 namespace {
@@ -81,8 +83,8 @@ std::string checked_module_version(const agnocastd::Config& config) {
   return version->to_string();
 }
 
-void stop_module(bool loaded_here, const agnocastd::Config& config) {
-  if (!loaded_here || !config.unload_on_exit) return;
+void stop_module(bool loaded_here, bool unload_on_exit) {
+  if (!loaded_here || !unload_on_exit) return;
   switch (agnocastd::unload_module()) {
     case agnocastd::UnloadResult::unloaded:
       spdlog::info("unloaded agnocast.ko");
@@ -96,7 +98,7 @@ void stop_module(bool loaded_here, const agnocastd::Config& config) {
   }
 }
 
-int run(const agnocastd::Config& config) {
+int run(const agnocastd::Config& config, std::function<agnocastd::Config()> reread_config) {
   // One daemon at a time, before touching anything.
   agnocastd::InstanceLock lock{std::string(agnocastd::lock_path)};
   // Stop signals queue up from here on; serve() reads them.
@@ -110,11 +112,21 @@ int run(const agnocastd::Config& config) {
   // Queues are listed and limited through the mqueue filesystem and sysctls.
   agnocastd::ensure_mqueue_mounted();
   agnocastd::apply_mqueue_limits(config.mqueue);
+  // unload_on_exit as the configuration in force at stop says.
+  bool unload_on_exit = config.unload_on_exit;
   {
     agnocast::ExitRecordReader exit_records;
+    // Before READY=1: no client may create an endpoint the policy would
+    // refuse. Set while exit_records is open, whose descriptor keeps the
+    // namespace's kernel state (and so the policy) alive.
+    agnocastd::apply_access_policy(config.access);
     agnocastd::SystemHost host;
-    agnocastd::Supervisor supervisor{config, host, exit_records,
-                                     std::string(agnocastd::status_path), module_version};
+    agnocastd::Supervisor supervisor{config,
+                                     std::move(reread_config),
+                                     host,
+                                     exit_records,
+                                     std::string(agnocastd::status_path),
+                                     module_version};
     // What died while no daemon ran: first the exits the kernel recorded, then the rest.
     agnocastd::clean_exited_processes(supervisor);
     agnocastd::sweep(host, supervisor.counters);
@@ -131,9 +143,10 @@ int run(const agnocastd::Config& config) {
     // Exits that raced the stop signal: nothing is left behind for the next start.
     agnocastd::clean_exited_processes(supervisor);
     agnocastd::write_status(supervisor, /*running=*/false);
+    unload_on_exit = supervisor.config.unload_on_exit;
   }
   // The exit-record descriptor is closed now; it would keep the module busy.
-  stop_module(loaded_here, config);
+  stop_module(loaded_here, unload_on_exit);
   spdlog::info("agnocastd stopped");
   return EXIT_SUCCESS;
 }
@@ -158,9 +171,10 @@ int main(int argc, char** argv) {
     return app.exit(error) == EXIT_SUCCESS ? EXIT_SUCCESS : exit_usage;  // --help is no error
   }
 
+  const bool config_given = app.count("--config") > 0;
   agnocastd::Config config;
   try {
-    config = read_config(options, app.count("--config") > 0);
+    config = read_config(options, config_given);
   } catch (const agnocastd::ConfigError& error) {
     fmt::print(stderr, "agnocastd: {}\n", error.what());
     return exit_usage;
@@ -172,7 +186,7 @@ int main(int argc, char** argv) {
 
   set_up_logging(config.log_level);
   try {
-    return run(config);
+    return run(config, [&options, config_given] { return read_config(options, config_given); });
   } catch (const std::exception& error) {
     spdlog::error("{}", error.what());
     return exit_failure;

@@ -87,8 +87,9 @@ class SystemSource final : public InspectionSource {
   }
 
   std::optional<QueueAttributes> queue_attributes(const std::string& queue_name) override {
-    // O_RDONLY | O_NONBLOCK and no mq_receive: looking never consumes a wake-up.
-    const mqd_t queue = ::mq_open(queue_name.c_str(), O_RDONLY | O_NONBLOCK);
+    // Write-only, as any publisher may (queues are 0622), and nothing sent:
+    // looking never consumes nor adds a wake-up.
+    const mqd_t queue = ::mq_open(queue_name.c_str(), O_WRONLY | O_NONBLOCK);
     if (queue == static_cast<mqd_t>(-1)) return std::nullopt;
     struct mq_attr attr {};
     const int rc = ::mq_getattr(queue, &attr);

@@ -1,6 +1,7 @@
 #include "notification_queue.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +16,9 @@ namespace agnocast::detail {
 namespace {
 
 constexpr std::size_t max_cached_senders = 256;
+// Publishers of every user may wake us (a spurious wake-up only costs a
+// RECEIVE that finds nothing); nobody but us may take our wake-ups.
+constexpr mode_t queue_mode = 0622;
 
 std::string creation_advice(int err) {
   switch (err) {
@@ -54,18 +58,25 @@ OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
   capacity_ = static_cast<std::size_t>(attributes.mq_maxmsg);
   attributes.mq_msgsize = sizeof(MqMsgAgnocast);
   const int flags = O_RDONLY | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
-  // Mode 0666 lets publishers of any user notify us; the umask still applies.
-  descriptor_ = ::mq_open(name.c_str(), flags, 0666, &attributes);
+  descriptor_ = ::mq_open(name.c_str(), flags, queue_mode, &attributes);
   if (descriptor_ == -1 && errno == EEXIST) {
     // The kernel never gives a live subscriber's id twice for a name, so this
     // queue is a leftover nobody owns: replace it.
     ::mq_unlink(name.c_str());
-    descriptor_ = ::mq_open(name.c_str(), flags, 0666, &attributes);
+    descriptor_ = ::mq_open(name.c_str(), flags, queue_mode, &attributes);
   }
   if (descriptor_ == -1) {
     const int err = errno;
     throw QueueError(err, "agnocast: cannot create notification queue " + name + ": " +
                               creation_advice(err) + " (" + std::strerror(err) + ")");
+  }
+  // mq_open applies the umask: set the mode itself.
+  if (::fchmod(descriptor_, queue_mode) != 0) {
+    const int err = errno;
+    ::mq_close(descriptor_);
+    ::mq_unlink(name.c_str());
+    throw QueueError(err, "agnocast: cannot set the mode of notification queue " + name + " (" +
+                              std::strerror(err) + ")");
   }
 }
 

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -68,6 +69,16 @@ TEST(NotificationQueue, SelfNotificationWakes) {
   queue.notify();
   queue.notify();
   EXPECT_EQ(pending(queue.fd()), 1);
+}
+
+TEST(NotificationQueue, AnyUserMayWakeButOnlyTheOwnerReadsWhateverTheUmask) {
+  const std::string name = queue_name(test_topic("mode"), 3);
+  const mode_t old_umask = ::umask(077);
+  OwnedQueue queue(name, 1);
+  ::umask(old_umask);
+  struct stat st {};
+  ASSERT_EQ(::fstat(queue.fd(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0622U);
 }
 
 TEST(NotificationQueue, DestructionUnlinks) {

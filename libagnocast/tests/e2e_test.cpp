@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sched.h>
 #include <sys/mount.h>
+#include <sys/stat.h>
 
 #include <agnocast/access_policy.hpp>
 #include <agnocast/inspect.hpp>
@@ -11,6 +12,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <thread>
 #include <tuple>
 
 #include "e2e_support.hpp"
@@ -703,6 +705,35 @@ TEST(Access, OutsideGroupAgnocastTheErrorSaysHowToJoin) {
     publish(*publisher, 1, 64);
     return 0;
   })));
+}
+
+// Publisher and subscriber of different users (both in group agnocast): the
+// subscriber's queue takes every wake-up whatever its umask.
+TEST(Access, UsersWakeEachOthersSubscribers) {
+  const std::string topic = unique_topic("users");
+  Pipe to_parent;
+  const pid_t listener = fork_child([&] {
+    if (::setgroups(1, &agnocast_group) != 0 || ::setgid(65534) != 0 || ::setuid(65534) != 0) {
+      return 100;
+    }
+    ::umask(077);
+    agnocast::Node node{"other_user"};
+    Received received;
+    auto subscription = node.create_subscription<Message>(topic, QoS{10}, received.recorder());
+    agnocast::SingleThreadedExecutor executor;
+    executor.add_node(node);
+    to_parent.send('r');
+    if (!spin_until(executor, [&] { return received.seqs.size() == 20; })) return 2;
+    return received.intact ? 0 : 3;
+  });
+  ASSERT_EQ(to_parent.receive(), 'r');
+  agnocast::Node node{"root_talker"};
+  auto publisher = node.create_publisher<Message>(topic, QoS{10});
+  for (std::uint64_t seq = 0; seq < 20; ++seq) {
+    publish(*publisher, seq, 256);
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_TRUE(exited_ok(wait_child(listener))) << "wake-ups lost across users";
 }
 
 TEST(Access, APolicyRefusalNamesTheTopicAndTheFix) {

@@ -124,6 +124,26 @@ TEST_F(CdrAgainstCyclone, NestedBoundedAndFixedContainers) {
   expect_same_bytes(wheel, &sample, golden_msgs_msg_Wheel_desc);
 }
 
+TEST_F(CdrAgainstCyclone, EmptySequencesAndStrings) {
+  golden_msgs::msg::Wheel wheel;  // every sequence empty, strings empty but `name`
+  wheel.tags.clear();
+  wheel.status = 1;
+  golden_msgs_msg_Wheel sample{};
+  sample.header.frame_id = const_cast<char*>("");
+  sample.tire = {220, const_cast<char*>("")};
+  std::strcpy(sample.name, "wheel");
+  sample.radius = 0.3;
+  sample.ticks[0] = 1;
+  sample.ticks[1] = -2;
+  sample.ticks[2] = 3;
+  sample.enabled = true;
+  for (auto& spare : sample.spares) spare = {220, const_cast<char*>("")};
+  sample.status = 1;
+  sample.code = 65;
+  sample.odometer = UINT64_MAX;
+  expect_same_bytes(wheel, &sample, golden_msgs_msg_Wheel_desc);
+}
+
 TEST_F(CdrAgainstCyclone, PointCloud2WithNestedSequenceOfStructs) {
   sensor_msgs::msg::PointCloud2 cloud;
   cloud.header.stamp = {1700000000, 5};

@@ -92,16 +92,28 @@ class Renderer {
   struct Elements {
     const std::byte* first;
     std::size_t count;
+    bool readable;
   };
+
+  bool readable(const void* address, std::size_t bytes) const {
+    return !options_.readable || options_.readable(address, bytes);
+  }
 
   // The elements of an array or sequence field whose bytes start at `at`.
   Elements elements_of(const SchemaField& field, const std::byte* at) const {
-    if (field.shape == FieldShape::Array) return {at, field.array_length};
+    if (field.shape == FieldShape::Array) return {at, field.array_length, true};
     const ContainerLayout& layout = schema_.containers;
-    const auto* begin = load<const std::byte*>(at + layout.vector_begin_offset);
-    const auto* end = load<const std::byte*>(at + layout.vector_end_offset);
-    return {begin, static_cast<std::size_t>(end - begin) / field.element_size};
+    const auto begin = load<std::uintptr_t>(at + layout.vector_begin_offset);
+    const auto end = load<std::uintptr_t>(at + layout.vector_end_offset);
+    const std::uintptr_t bytes = end - begin;
+    const auto* first = reinterpret_cast<const std::byte*>(begin);
+    if (end < begin || bytes % field.element_size != 0 || !readable(first, bytes)) {
+      return {nullptr, 0, false};
+    }
+    return {first, bytes / field.element_size, true};
   }
+
+  void unreadable() { out_ += json_ ? "null" : "<unreadable>"; }
 
   // `first_prefix` replaces the indentation of the first line (a list item's "- ").
   void text_message(const SchemaType& type, const std::byte* at, std::size_t indent,
@@ -126,7 +138,11 @@ class Renderer {
         continue;
       }
       const Elements elements = elements_of(field, value);
-      if (!options_.show_arrays) {
+      if (!elements.readable) {
+        out_ += ' ';
+        unreadable();
+        out_ += '\n';
+      } else if (!options_.show_arrays) {
         out_ += " <" + std::to_string(elements.count) + " elements>\n";
       } else if (!nested || elements.count == 0) {
         out_ += " [";
@@ -160,6 +176,10 @@ class Renderer {
         continue;
       }
       const Elements elements = elements_of(field, value);
+      if (!elements.readable) {
+        unreadable();
+        continue;
+      }
       if (!options_.show_arrays) {
         out_ += "{\"length\":" + std::to_string(elements.count) + "}";
         continue;
@@ -232,7 +252,11 @@ class Renderer {
         const ContainerLayout& layout = schema_.containers;
         const auto* data = load<const char*>(at + layout.string_data_offset);
         const auto length = load<std::size_t>(at + layout.string_length_offset);
-        append_quoted(out_, std::string_view(data, length));
+        if (readable(data, length)) {
+          append_quoted(out_, std::string_view(data, length));
+        } else {
+          unreadable();
+        }
         break;
       }
       case FieldKind::Opaque:

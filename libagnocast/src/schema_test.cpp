@@ -20,8 +20,18 @@ struct Track {
   agnocast::vector<agnocast::string> tags;
 };
 
+// More fields than a shallow preprocessor loop would reach.
+struct Wide {
+  std::uint8_t f0, f1, f2, f3, f4, f5, f6, f7, f8, f9, f10, f11, f12, f13, f14, f15, f16, f17, f18,
+      f19, f20, f21, f22, f23, f24, f25, f26, f27, f28, f29, f30, f31, f32, f33, f34, f35, f36, f37,
+      f38, f39;
+};
+
 }  // namespace schema_test
 
+AGNOCAST_MESSAGE(schema_test::Wide, "schema_test/msg/Wide", f0, f1, f2, f3, f4, f5, f6, f7, f8, f9,
+                 f10, f11, f12, f13, f14, f15, f16, f17, f18, f19, f20, f21, f22, f23, f24, f25,
+                 f26, f27, f28, f29, f30, f31, f32, f33, f34, f35, f36, f37, f38, f39);
 AGNOCAST_MESSAGE(schema_test::Point, "schema_test/msg/Point", x, y);
 AGNOCAST_MESSAGE(schema_test::Track, "schema_test/msg/Track", id, label, last, history, box, tags);
 
@@ -55,6 +65,13 @@ TEST(Schema, RoundTripsEveryTypeAndField) {
   EXPECT_EQ(schema.types[1].fields[1].kind, FieldKind::Float32);
   EXPECT_EQ(schema.containers.vector_size, sizeof(agnocast::vector<int>));
   EXPECT_EQ(schema.containers.string_size, sizeof(agnocast::string));
+}
+
+TEST(Schema, AgnocastMessageTakesManyFields) {
+  const auto& fields = message_traits<schema_test::Wide>::fields;
+  ASSERT_EQ(fields.size(), 40u);
+  EXPECT_EQ(fields[39].name, "f39");
+  EXPECT_EQ(fields[39].offset, offsetof(schema_test::Wide, f39));
 }
 
 TEST(Schema, HeaderIsVersionedAndSized) {

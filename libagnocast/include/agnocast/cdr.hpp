@@ -52,13 +52,13 @@ class Writer {
 
   template <class E, std::size_t N>
   void write(const std::array<E, N>& elements) {
-    for (const E& element : elements) write(element);
+    write_elements(elements.data(), N);
   }
 
   template <class E, class Allocator>
   void write(const std::vector<E, Allocator>& elements) {
     write(static_cast<std::uint32_t>(elements.size()));
-    for (const E& element : elements) write(element);
+    write_elements(elements.data(), elements.size());
   }
 
   template <class Message>
@@ -67,6 +67,20 @@ class Writer {
   }
 
  private:
+  template <class E>
+  void write_elements(const E* elements, std::size_t count) {
+    if constexpr (std::is_arithmetic_v<E>) {
+      // Consecutive primitives of one size need no padding between them: one copy.
+      if (count == 0) return;
+      align(sizeof(E));
+      const auto at = out_.size();
+      out_.resize(at + count * sizeof(E));
+      std::memcpy(out_.data() + at, elements, count * sizeof(E));
+    } else {
+      for (std::size_t i = 0; i < count; ++i) write(elements[i]);
+    }
+  }
+
   void align(std::size_t size) {
     const std::size_t position = out_.size() - origin_;
     out_.resize(out_.size() + (size - position % size) % size, 0);
@@ -104,7 +118,7 @@ class Reader {
 
   template <class E, std::size_t N>
   void read(std::array<E, N>& elements) {
-    for (E& element : elements) read(element);
+    read_elements(elements.data(), N);
   }
 
   template <class E, class Allocator>
@@ -114,7 +128,7 @@ class Reader {
     if (count > remaining()) throw Error("cdr: sequence longer than the input");
     elements.clear();
     elements.resize(count);
-    for (E& element : elements) read(element);
+    read_elements(elements.data(), count);
   }
 
   template <class Message>
@@ -123,6 +137,18 @@ class Reader {
   std::size_t remaining() const { return in_.size() - position_; }
 
  private:
+  template <class E>
+  void read_elements(E* elements, std::size_t count) {
+    if constexpr (std::is_arithmetic_v<E> && !std::is_same_v<E, bool>) {
+      if (count == 0) return;
+      align(sizeof(E));
+      if (count > remaining() / sizeof(E)) throw Error("cdr: input ends inside the message");
+      std::memcpy(elements, take(count * sizeof(E)), count * sizeof(E));
+    } else {
+      for (std::size_t i = 0; i < count; ++i) read(elements[i]);  // bools are checked one by one
+    }
+  }
+
   std::uint32_t read_count() {
     std::uint32_t count = 0;
     read(count);

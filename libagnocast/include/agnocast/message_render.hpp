@@ -3,6 +3,8 @@
 // the addresses they point to (a subscriber's read-only mapping of the pool).
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <string>
 
 #include "agnocast/schema.hpp"
@@ -12,6 +14,11 @@ namespace agnocast {
 struct RenderOptions {
   // false: arrays and sequences show their length only (echo --no-arrays).
   bool show_arrays = true;
+  // When set, the bytes of every string and sequence the message points to are
+  // read only if this says they are mapped (e.g. inside a publisher's pool);
+  // otherwise, and for a vector whose pointers make no sense, the value is shown
+  // as <unreadable> (JSON null). Unset: every pointer is trusted.
+  std::function<bool(const void* address, std::size_t bytes)> readable = nullptr;
 };
 
 // YAML-like text, one field per line, nested messages indented by two spaces;

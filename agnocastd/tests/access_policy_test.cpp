@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include "chatter_message.hpp"
+
 namespace {
 
 using nlohmann::json;
@@ -84,9 +86,8 @@ bool eventually(const std::function<bool()>& condition, std::chrono::millisecond
   return true;
 }
 
-struct Sample {
-  std::uint64_t value = 0;
-};
+// The topics' type: the talker's and listener's message.
+using Sample = chatter::Message;
 
 enum class Direction { publish, subscribe };
 constexpr int created = 0;
@@ -191,8 +192,6 @@ TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
       spawn(&safety_member,
             {"agnocast-talker", "--topic", "/safety/brake", "--rate", "100", "--linger", "0"},
             "talker.log");
-  // The same user as the talker: wake-ups go through the listener's queue,
-  // which the umask may keep other users from writing.
   const pid_t listener = spawn(
       &safety_member, {"agnocast-listener", "--topic", "/safety/brake", "--json"}, "listener.log");
   const auto published = [] {

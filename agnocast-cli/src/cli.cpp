@@ -24,6 +24,7 @@ bool wants_json(int argc, const char* const* argv) {
 }
 
 int run_chosen(const Command& command, bool json, std::ostream& out, std::ostream& err) {
+  if (command.stream) return command.stream(out);
   const nlohmann::json value = command.build();
   if (json) {
     out << value.dump() << '\n';

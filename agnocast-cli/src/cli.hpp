@@ -32,6 +32,9 @@ struct Command {
   std::function<int(const nlohmann::json&)> exit_code = {};
   // A line for stderr derived from the value (a hint), empty for none; may be nullptr.
   std::function<std::string(const nlohmann::json&)> advice = {};
+  // Set for a streaming command (topic echo): it writes its own output as it
+  // goes and returns the exit code; the members above are then unused.
+  std::function<int(std::ostream& out)> stream = {};
 };
 
 // Shared by every subcommand while the command line is parsed.

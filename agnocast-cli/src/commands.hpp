@@ -4,7 +4,10 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstddef>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <ostream>
 #include <string>
 #include <string_view>
 
@@ -23,6 +26,20 @@ nlohmann::json topic_hz_json(InspectionSource& source, const std::string& topic,
 std::string topic_list_table(const nlohmann::json& value);
 std::string topic_info_table(const nlohmann::json& value);
 std::string topic_hz_table(const nlohmann::json& value);
+
+// topic echo TOPIC: subscribes and prints every message decoded from the schema
+// its publisher registered, until --count messages, --timeout or a signal.
+struct EchoOptions {
+  std::string topic;
+  std::optional<std::size_t> count;  // stop after this many (exit 0)
+  std::optional<double> timeout_s;   // give up (exit 1) when fewer arrived by then
+  bool show_arrays = true;
+  bool json = false;  // JSON Lines instead of YAML-like text
+};
+// A subcommand of `topic`.
+void set_topic_echo_command(CLI::App& topic, Context& context);
+// Writes the messages to `out`; returns the exit code, throws CliError on a timeout.
+int topic_echo(InspectionSource& source, const EchoOptions& options, std::ostream& out);
 
 void set_queue_command(CLI::App& app, Context& context);
 nlohmann::json queue_list_json(InspectionSource& source);

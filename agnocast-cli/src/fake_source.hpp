@@ -4,11 +4,37 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <utility>
 
 #include "agnocast/errors.hpp"
+#include "agnocast/schema_subscriber.hpp"
 #include "inspection_source.hpp"
 
 namespace agnocast::cli {
+
+// What a subscription to one topic yields: the registered schema blob and the
+// messages in place with their readable range, taken oldest first.
+struct FakeStream {
+  std::vector<std::uint8_t> schema;
+  std::vector<std::pair<const void*, std::span<const std::byte>>> messages;
+};
+
+class FakeTap : public MessageTap {
+ public:
+  explicit FakeTap(FakeStream& stream) : stream_(stream), schema_(parse_schema(stream.schema)) {}
+  const Schema& schema() const override { return schema_; }
+  bool take(const Reader& read) override {
+    if (next_ == stream_.messages.size()) return false;
+    const auto& [message, readable] = stream_.messages[next_++];
+    read(message, readable);
+    return true;
+  }
+
+ private:
+  FakeStream& stream_;  // messages may be added while subscribed
+  Schema schema_;
+  std::size_t next_ = 0;
+};
 
 class FakeSource : public InspectionSource {
  public:
@@ -29,6 +55,8 @@ class FakeSource : public InspectionSource {
   double unix_clock = 1'700'000'100.0;
   // Applied to `topics` on each sleep, to play counters advancing.
   std::function<void(FakeSource&)> on_sleep;
+  std::map<std::string, FakeStream> streams;  // by topic; none: the topic has no schema
+  bool stop = false;                          // SIGINT or SIGTERM arrived
 
   std::optional<Version> module_version() override {
     return loaded ? std::optional(version) : std::nullopt;
@@ -38,8 +66,7 @@ class FakeSource : public InspectionSource {
     std::vector<TopicSummary> list;
     for (const TopicInfo& t : topics) {
       list.push_back({t.name, static_cast<std::uint32_t>(t.publishers.size()),
-                      static_cast<std::uint32_t>(t.subscribers.size()), t.type_name,
-                      t.type_hash});
+                      static_cast<std::uint32_t>(t.subscribers.size()), t.type_name, t.type_hash});
     }
     return list;
   }
@@ -80,6 +107,13 @@ class FakeSource : public InspectionSource {
     const auto it = locks.find(path);
     return it == locks.end() ? std::nullopt : std::optional(it->second);
   }
+  std::unique_ptr<MessageTap> subscribe(const std::string& topic) override {
+    if (!topic_info(topic)) throw TopicWithoutSchema("no publisher or subscriber uses " + topic);
+    const auto stream = streams.find(topic);
+    if (stream == streams.end()) throw TopicWithoutSchema(topic + " has no schema");
+    return std::make_unique<FakeTap>(stream->second);
+  }
+  bool stop_requested() override { return stop; }
   double now_seconds() override { return clock; }
   double unix_time() override { return unix_clock; }
   void sleep_seconds(double seconds) override {

@@ -4,16 +4,34 @@
 
 #include <sys/types.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "agnocast/access_policy.hpp"
 #include "agnocast/inspect.hpp"
+#include "agnocast/schema.hpp"
 #include "agnocast/version.hpp"
 
 namespace agnocast::cli {
+
+// A polling subscription whose message type is known only from the schema the
+// topic's endpoints registered (topic echo).
+class MessageTap {
+ public:
+  // The message in place and the only bytes a reader may touch (the publisher's pool).
+  using Reader = std::function<void(const void* message, std::span<const std::byte> readable)>;
+
+  virtual ~MessageTap() = default;
+  virtual const Schema& schema() const = 0;
+  // Runs `read` on the newest message not taken yet, held meanwhile; false when none.
+  virtual bool take(const Reader& read) = 0;
+};
 
 // What mq_getattr says of a queue, read without consuming anything.
 struct QueueAttributes {
@@ -53,6 +71,12 @@ class InspectionSource {
   // a non-blocking shared lock on a read-only descriptor); nullopt when the
   // file cannot be opened.
   virtual std::optional<bool> exclusively_locked(const std::string& path) = 0;
+
+  // Subscribes to `topic` with the type its endpoints registered; throws
+  // agnocast::TopicWithoutSchema when it has no endpoint or no schema.
+  virtual std::unique_ptr<MessageTap> subscribe(const std::string& topic) = 0;
+  // True once SIGINT or SIGTERM asked a streaming command to stop.
+  virtual bool stop_requested() = 0;
 
   // Monotonic seconds and a sleep, for sampling counters over a window.
   virtual double now_seconds() = 0;

@@ -17,6 +17,9 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/inspect.hpp"
 #include "agnocast/naming.hpp"
+#include "agnocast/node.hpp"
+#include "agnocast/schema_subscriber.hpp"
+#include "agnocast/signals.hpp"
 #include "inspection_source.hpp"
 
 namespace agnocast::cli {
@@ -51,6 +54,26 @@ std::optional<std::string> name_of_id(std::uint32_t id, Lookup lookup, NameOf na
     return std::string(name_of(*found));
   }
 }
+
+// topic echo's subscriber, in a node of its own so `topic info` names it.
+class SystemTap final : public MessageTap {
+ public:
+  explicit SystemTap(const std::string& topic)
+      : node_("agnocast_cli_echo"), subscriber_(node_, topic, QoS(echo_depth)) {}
+
+  const Schema& schema() const override { return subscriber_.schema(); }
+  bool take(const Reader& read) override {
+    const std::optional<SchemaMessage> message = subscriber_.take();
+    if (!message) return false;
+    read(message->data(), message->readable());
+    return true;
+  }
+
+ private:
+  static constexpr std::size_t echo_depth = 10;
+  Node node_;
+  SchemaSubscriber subscriber_;
+};
 
 class SystemSource final : public InspectionSource {
  public:
@@ -97,6 +120,12 @@ class SystemSource final : public InspectionSource {
     if (rc != 0) return std::nullopt;
     return QueueAttributes{attr.mq_curmsgs, attr.mq_maxmsg};
   }
+
+  std::unique_ptr<MessageTap> subscribe(const std::string& topic) override {
+    install_signal_handlers();
+    return std::make_unique<SystemTap>(topic);
+  }
+  bool stop_requested() override { return !agnocast::ok(); }
 
   bool path_exists(const std::string& path) override { return ::access(path.c_str(), F_OK) == 0; }
   int path_access(const std::string& path, int mode) override {

@@ -1,4 +1,4 @@
-// agnocast-cli topic list | info TOPIC | hz TOPIC [--window SEC]
+// agnocast-cli topic list | info TOPIC | hz TOPIC [--window SEC] (echo: echo.cpp)
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -188,6 +188,7 @@ void set_topic_command(CLI::App& app, Context& context) {
   bind_command(*hz, context,
                {[&context, name, window] { return topic_hz_json(context.source, *name, *window); },
                 topic_hz_table});
+  set_topic_echo_command(*topic, context);
 }
 
 }  // namespace agnocast::cli

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string_view>
 
@@ -65,7 +66,10 @@ class Renderer {
   std::string text(const void* message) {
     json_ = false;
     const SchemaType& root = schema_.types[0];
-    if (root.fields.empty()) {
+    if (const char* problem = root_problem(message, root)) {
+      marker(problem);
+      out_ += '\n';
+    } else if (root.fields.empty()) {
       out_ += "bytes: ";  // a raw type: its bytes are all there is to show
       append_bytes(static_cast<const std::byte*>(message), root.size);
       out_ += '\n';
@@ -78,7 +82,9 @@ class Renderer {
   std::string json(const void* message) {
     json_ = true;
     const SchemaType& root = schema_.types[0];
-    if (root.fields.empty()) {
+    if (const char* problem = root_problem(message, root)) {
+      marker(problem);
+    } else if (root.fields.empty()) {
       out_ += "{\"bytes\":";
       append_bytes(static_cast<const std::byte*>(message), root.size);
       out_ += '}';
@@ -90,30 +96,87 @@ class Renderer {
 
  private:
   struct Elements {
-    const std::byte* first;
-    std::size_t count;
-    bool readable;
+    const std::byte* first = nullptr;
+    std::size_t count = 0;
+    const char* problem = nullptr;  // set: render this instead of the elements
   };
 
-  bool readable(const void* address, std::size_t bytes) const {
-    return !options_.readable || options_.readable(address, bytes);
+  bool checked() const { return options_.readable.has_value(); }
+
+  // Whether `bytes` bytes from `at` lie in the readable range (always, unchecked).
+  bool readable(std::uintptr_t at, std::size_t bytes) const {
+    if (!checked()) return true;
+    const auto begin = reinterpret_cast<std::uintptr_t>(options_.readable->data());
+    const std::uintptr_t end = begin + options_.readable->size();
+    return at >= begin && at <= end && bytes <= end - at;
+  }
+
+  // Alignments a schema gives that are no power of two are not checked.
+  static bool aligned(std::uintptr_t at, std::uint32_t align) {
+    const bool power_of_two = align != 0 && (align & (align - 1)) == 0;
+    return !power_of_two || at % align == 0;
+  }
+
+  const char* root_problem(const void* message, const SchemaType& root) const {
+    if (!checked()) return nullptr;
+    const auto at = reinterpret_cast<std::uintptr_t>(message);
+    if (!readable(at, root.size)) return "message outside the publisher's pool";
+    if (!aligned(at, root.align)) return "misaligned message";
+    return nullptr;
+  }
+
+  // Takes `count` from the budget of values a checked message may show.
+  bool spend(std::size_t count) {
+    if (!checked()) return true;
+    if (count > budget_) return false;
+    budget_ -= count;
+    return true;
   }
 
   // The elements of an array or sequence field whose bytes start at `at`.
+  // Each pointer is loaded once: a publisher may rewrite it meanwhile.
   Elements elements_of(const SchemaField& field, const std::byte* at) const {
-    if (field.shape == FieldShape::Array) return {at, field.array_length, true};
+    if (field.shape == FieldShape::Array) return {at, field.array_length};
     const ContainerLayout& layout = schema_.containers;
     const auto begin = load<std::uintptr_t>(at + layout.vector_begin_offset);
     const auto end = load<std::uintptr_t>(at + layout.vector_end_offset);
-    const std::uintptr_t bytes = end - begin;
     const auto* first = reinterpret_cast<const std::byte*>(begin);
-    if (end < begin || bytes % field.element_size != 0 || !readable(first, bytes)) {
-      return {nullptr, 0, false};
+    if (!checked()) return {first, (end - begin) / field.element_size};
+    if (end < begin) return {.problem = "sequence ends before its begin"};
+    const std::size_t bytes = end - begin;
+    if (bytes % field.element_size != 0) {
+      return {.problem = "sequence length is no whole number of elements"};
     }
-    return {first, bytes / field.element_size, true};
+    const std::size_t count = bytes / field.element_size;
+    if (field.sequence_bound != 0 && count > field.sequence_bound) {
+      return {.problem = "sequence longer than its bound"};
+    }
+    if (count == 0) return {};
+    if (!aligned(begin, field.element_align)) return {.problem = "misaligned sequence"};
+    if (!readable(begin, bytes)) return {.problem = "sequence outside the publisher's pool"};
+    return {first, count};
   }
 
-  void unreadable() { out_ += json_ ? "null" : "<unreadable>"; }
+  // Elements to show: a problem, or the budget exhausted, makes a marker.
+  Elements shown_elements(const SchemaField& field, const std::byte* at) {
+    Elements elements = elements_of(field, at);
+    if (!elements.problem && options_.show_arrays && !spend(elements.count)) {
+      elements.problem = "too many values to show";
+    }
+    return elements;
+  }
+
+  void marker(const char* problem) {
+    if (json_) {
+      out_ += "{\"invalid\":";
+      append_quoted(out_, problem);
+      out_ += '}';
+    } else {
+      out_ += "<invalid: ";
+      out_ += problem;
+      out_ += '>';
+    }
+  }
 
   // `first_prefix` replaces the indentation of the first line (a list item's "- ").
   void text_message(const SchemaType& type, const std::byte* at, std::size_t indent,
@@ -137,10 +200,10 @@ class Renderer {
         }
         continue;
       }
-      const Elements elements = elements_of(field, value);
-      if (!elements.readable) {
+      const Elements elements = shown_elements(field, value);
+      if (elements.problem) {
         out_ += ' ';
-        unreadable();
+        marker(elements.problem);
         out_ += '\n';
       } else if (!options_.show_arrays) {
         out_ += " <" + std::to_string(elements.count) + " elements>\n";
@@ -175,9 +238,9 @@ class Renderer {
         json_element(field, value);
         continue;
       }
-      const Elements elements = elements_of(field, value);
-      if (!elements.readable) {
-        unreadable();
+      const Elements elements = shown_elements(field, value);
+      if (elements.problem) {
+        marker(elements.problem);
         continue;
       }
       if (!options_.show_arrays) {
@@ -250,12 +313,14 @@ class Renderer {
         break;
       case FieldKind::String: {
         const ContainerLayout& layout = schema_.containers;
-        const auto* data = load<const char*>(at + layout.string_data_offset);
+        const auto data = load<std::uintptr_t>(at + layout.string_data_offset);
         const auto length = load<std::size_t>(at + layout.string_length_offset);
-        if (readable(data, length)) {
-          append_quoted(out_, std::string_view(data, length));
+        if (const char* problem = string_problem(field, data, length)) {
+          marker(problem);
         } else {
-          unreadable();
+          append_quoted(out_, length == 0
+                                  ? ""
+                                  : std::string_view(reinterpret_cast<const char*>(data), length));
         }
         break;
       }
@@ -266,8 +331,19 @@ class Renderer {
     }
   }
 
+  const char* string_problem(const SchemaField& field, std::uintptr_t data, std::size_t length) {
+    if (!checked() || length == 0) return nullptr;
+    if (field.string_bound != 0 && length > field.string_bound) {
+      return "string longer than its bound";
+    }
+    if (!readable(data, length)) return "string outside the publisher's pool";
+    if (!spend(length)) return "too many values to show";
+    return nullptr;
+  }
+
   const Schema& schema_;
   const RenderOptions& options_;
+  std::size_t budget_ = options_.max_values;
   bool json_ = false;
   std::string out_;
 };

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <iterator>
 #include <sstream>
 #include <vector>
 
@@ -203,6 +204,20 @@ void Runtime::map_pool(const PoolGrant& grant) {
   map_at(grant.addr, grant.size, PROT_READ, grant.fd, replace,
          "the pool of publisher pid " + std::to_string(grant.pid));
   mapped_pools_[grant.addr] = grant.size;
+}
+
+std::span<const std::byte> Runtime::pool_holding(const void* address) {
+  const auto at = reinterpret_cast<std::uint64_t>(address);
+  const auto own = reinterpret_cast<std::uint64_t>(pool_addr_);
+  if (at >= own && at - own < pool_size_) {
+    return {static_cast<const std::byte*>(pool_addr_), pool_size_};
+  }
+  std::lock_guard lock(mapped_mutex_);
+  auto after = mapped_pools_.upper_bound(at);
+  if (after == mapped_pools_.begin()) return {};
+  const auto& [addr, size] = *std::prev(after);
+  if (at - addr >= size) return {};
+  return {reinterpret_cast<const std::byte*>(addr), static_cast<std::size_t>(size)};
 }
 
 // The message functions of detail/message.hpp and allocator.hpp, over the runtime.

@@ -42,6 +42,9 @@ class Runtime {
 
   // Maps a publisher's pool read-only at its address and closes grant.fd.
   void map_pool(const PoolGrant& grant);
+  // The pool mapped here (a publisher's, or this process's own) that holds
+  // `address`: all a reader of a message there may touch. Empty when none does.
+  std::span<const std::byte> pool_holding(const void* address);
 
  private:
   Runtime(std::optional<Device> device, pid_t pid, void* pool_addr, std::size_t pool_size);

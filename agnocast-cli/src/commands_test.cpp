@@ -24,12 +24,14 @@ TEST(TopicList, CountsEndpointsPerTopicSortedByName) {
   early.name = "/a";
   source.topics.push_back(early);
   const json value = topic_list_json(source);
-  EXPECT_EQ(value, json::parse(R"({"topics":[{"name":"/a","publishers":0,"subscribers":0},
-                                   {"name":"/chatter","publishers":1,"subscribers":2}]})"));
+  EXPECT_EQ(value,
+            json::parse(R"({"topics":[{"name":"/a","type":null,"publishers":0,"subscribers":0},
+                        {"name":"/chatter","type":"chatter/msg/Message","publishers":1,
+                         "subscribers":2}]})"));
   EXPECT_EQ(topic_list_table(value),
-            "NAME      PUBLISHERS  SUBSCRIBERS\n"
-            "/a                 0            0\n"
-            "/chatter           1            2\n");
+            "NAME      TYPE                 PUBLISHERS  SUBSCRIBERS\n"
+            "/a        -                             0            0\n"
+            "/chatter  chatter/msg/Message           1            2\n");
 }
 
 TEST(TopicList, ModuleAbsentThrowsModuleNotLoaded) {
@@ -41,12 +43,19 @@ TEST(TopicList, ModuleAbsentThrowsModuleNotLoaded) {
 TEST(TopicInfo, HasSpecFieldsQueueDepthFromMqueueAndNullQueueForPolling) {
   FakeSource source = healthy_system();
   const json value = topic_info_json(source, "/chatter");
-  EXPECT_EQ(keys_of(value), (std::vector<std::string>{"name", "publishers", "subscribers"}));
-  EXPECT_EQ(value["publishers"][0], json::parse(R"({"id":0,"pid":100,"node":"talker","depth":10,
-                                                    "transient_local":false,"published":42})"));
+  EXPECT_EQ(keys_of(value),
+            (std::vector<std::string>{"name", "publishers", "subscribers", "type", "type_hash"}));
+  EXPECT_EQ(value["type"], "chatter/msg/Message");
+  EXPECT_EQ(value["type_hash"], "31d0e2409f905fac");
+  EXPECT_EQ(value["publishers"][0],
+            json::parse(R"({"id":0,"pid":100,"uid":1000,"node":"talker","depth":10,
+                            "transient_local":false,"published":42})"));
   EXPECT_EQ(value["subscribers"][0],
-            json::parse(R"({"id":1,"pid":200,"node":"listener","depth":10,"queue":"/chatter@1",
-                            "pending":3,"unreceived":3,"dropped":1})"));
+            json::parse(R"({"id":1,"pid":200,"uid":1001,"node":"listener","depth":10,
+                            "transient_local":false,"polling":false,"queue":"/chatter@1",
+                            "pending":3,"unreceived":3,"held":2,"received":37,"dropped":1})"));
+  EXPECT_EQ(value["subscribers"][1]["polling"], true);
+  EXPECT_EQ(value["subscribers"][1]["transient_local"], true);
   EXPECT_TRUE(value["subscribers"][1]["queue"].is_null());
   EXPECT_TRUE(value["subscribers"][1]["pending"].is_null());
 }
@@ -55,15 +64,19 @@ TEST(TopicInfo, TableShowsBothSections) {
   FakeSource source = healthy_system();
   EXPECT_EQ(topic_info_table(topic_info_json(source, "/chatter")),
             "topic /chatter\n"
+            "type  chatter/msg/Message (31d0e2409f905fac)\n"
             "\n"
             "publishers\n"
-            "ID  PID  NODE    DEPTH  TRANSIENT_LOCAL  PUBLISHED\n"
-            " 0  100  talker     10  no                      42\n"
+            "ID  PID   UID  NODE    DEPTH  TRANSIENT_LOCAL  PUBLISHED\n"
+            " 0  100  1000  talker     10  no                      42\n"
             "\n"
             "subscribers\n"
-            "ID  PID  NODE      DEPTH  QUEUE       PENDING  UNRECEIVED  DROPPED\n"
-            " 1  200  listener     10  /chatter@1        3           3        1\n"
-            " 2  300  poller        1  -                 -           0        0\n");
+            "ID  PID   UID  NODE      DEPTH  TRANSIENT_LOCAL  QUEUE       PENDING  UNRECEIVED  "
+            "HELD  RECEIVED  DROPPED\n"
+            " 1  200  1001  listener     10  no               /chatter@1        3           3  "
+            "   2        37        1\n"
+            " 2  300  1001  poller        1  yes              (polling)         -           0  "
+            "   0         0        0\n");
 }
 
 TEST(TopicInfo, UnknownTopicIsARuntimeErrorNamingTopicList) {

@@ -138,6 +138,8 @@ inline FakeSource healthy_system() {
   FakeSource source;
   TopicInfo chatter;
   chatter.name = "/chatter";
+  chatter.type_name = "chatter/msg/Message";
+  chatter.type_hash = 0x31d0e2409f905facULL;
   PublisherInfo talker;
   talker.id = 0;
   talker.pid = 100;
@@ -145,6 +147,7 @@ inline FakeSource healthy_system() {
   talker.depth = 10;
   talker.published = 42;
   talker.published_bytes = 42 * 1024;
+  talker.uid = 1000;
   chatter.publishers.push_back(talker);
   SubscriberInfo listener;
   listener.id = 1;
@@ -153,6 +156,9 @@ inline FakeSource healthy_system() {
   listener.depth = 10;
   listener.unreceived = 3;
   listener.dropped = 1;
+  listener.held = 2;
+  listener.received = 37;
+  listener.uid = 1001;
   chatter.subscribers.push_back(listener);
   SubscriberInfo poller;
   poller.id = 2;
@@ -160,6 +166,8 @@ inline FakeSource healthy_system() {
   poller.node = "poller";
   poller.depth = 1;
   poller.polling = true;
+  poller.transient_local = true;
+  poller.uid = 1001;
   chatter.subscribers.push_back(poller);
   source.topics.push_back(chatter);
   source.queues["/chatter@1"] = {3, 10};

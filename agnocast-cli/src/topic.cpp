@@ -1,6 +1,7 @@
 // agnocast-cli topic list | info TOPIC | hz TOPIC [--window SEC] (echo: echo.cpp)
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "agnocast/naming.hpp"
@@ -30,6 +31,17 @@ json pending_of(InspectionSource& source, const std::optional<std::string>& queu
   return attributes ? json(attributes->pending) : json(nullptr);
 }
 
+// A topic's type, null for one whose endpoints declared none.
+json type_of(const std::string& type_name) {
+  return type_name.empty() ? json(nullptr) : json(type_name);
+}
+
+std::string hex64(std::uint64_t value) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
 const CLI::Validator topic_name_validator(
     [](std::string& topic) { return topic_name_problem(topic); }, "TOPIC", "topic name");
 
@@ -42,6 +54,7 @@ json topic_list_json(InspectionSource& source) {
   json list = json::array();
   for (const TopicSummary& topic : topics) {
     list.push_back({{"name", topic.name},
+                    {"type", type_of(topic.type_name)},
                     {"publishers", topic.publishers},
                     {"subscribers", topic.subscribers}});
   }
@@ -61,7 +74,8 @@ json topic_info_json(InspectionSource& source, const std::string& topic) {
                           {"node", p.node},
                           {"depth", p.depth},
                           {"transient_local", p.transient_local},
-                          {"published", p.published}});
+                          {"published", p.published},
+                          {"uid", p.uid}});
   }
   json subscribers = json::array();
   for (const SubscriberInfo& s : info.subscribers) {
@@ -75,9 +89,18 @@ json topic_info_json(InspectionSource& source, const std::string& topic) {
                            {"queue", queue ? json(*queue) : json(nullptr)},
                            {"pending", pending_of(source, queue)},
                            {"unreceived", s.unreceived},
-                           {"dropped", s.dropped}});
+                           {"dropped", s.dropped},
+                           {"uid", s.uid},
+                           {"transient_local", s.transient_local},
+                           {"polling", s.polling},
+                           {"held", s.held},
+                           {"received", s.received}});
   }
-  return {{"name", info.name}, {"publishers", publishers}, {"subscribers", subscribers}};
+  return {{"name", info.name},
+          {"type", type_of(info.type_name)},
+          {"type_hash", hex64(info.type_hash)},
+          {"publishers", publishers},
+          {"subscribers", subscribers}};
 }
 
 json topic_hz_json(InspectionSource& source, const std::string& topic, double window_s) {
@@ -118,9 +141,10 @@ json topic_hz_json(InspectionSource& source, const std::string& topic, double wi
 }
 
 std::string topic_list_table(const json& value) {
-  Table table({{"NAME"}, {"PUBLISHERS", Align::right}, {"SUBSCRIBERS", Align::right}});
+  Table table({{"NAME"}, {"TYPE"}, {"PUBLISHERS", Align::right}, {"SUBSCRIBERS", Align::right}});
   for (const json& t : value.at("topics")) {
-    table.add_row({cell(t.at("name")), cell(t.at("publishers")), cell(t.at("subscribers"))});
+    table.add_row({cell(t.at("name")), cell(t.at("type")), cell(t.at("publishers")),
+                   cell(t.at("subscribers"))});
   }
   return table.render();
 }
@@ -128,30 +152,39 @@ std::string topic_list_table(const json& value) {
 std::string topic_info_table(const json& value) {
   Table publishers({{"ID", Align::right},
                     {"PID", Align::right},
+                    {"UID", Align::right},
                     {"NODE"},
                     {"DEPTH", Align::right},
                     {"TRANSIENT_LOCAL"},
                     {"PUBLISHED", Align::right}});
   for (const json& p : value.at("publishers")) {
-    publishers.add_row({cell(p.at("id")), cell(p.at("pid")), cell(p.at("node")),
+    publishers.add_row({cell(p.at("id")), cell(p.at("pid")), cell(p.at("uid")), cell(p.at("node")),
                         cell(p.at("depth")), cell(p.at("transient_local")),
                         cell(p.at("published"))});
   }
   Table subscribers({{"ID", Align::right},
                      {"PID", Align::right},
+                     {"UID", Align::right},
                      {"NODE"},
                      {"DEPTH", Align::right},
+                     {"TRANSIENT_LOCAL"},
                      {"QUEUE"},
                      {"PENDING", Align::right},
                      {"UNRECEIVED", Align::right},
+                     {"HELD", Align::right},
+                     {"RECEIVED", Align::right},
                      {"DROPPED", Align::right}});
   for (const json& s : value.at("subscribers")) {
-    subscribers.add_row({cell(s.at("id")), cell(s.at("pid")), cell(s.at("node")),
-                         cell(s.at("depth")), cell(s.at("queue")), cell(s.at("pending")),
-                         cell(s.at("unreceived")), cell(s.at("dropped"))});
+    // A polling subscriber has no queue: its QUEUE cell says so.
+    const json queue = s.at("polling").get<bool>() ? json("(polling)") : s.at("queue");
+    subscribers.add_row({cell(s.at("id")), cell(s.at("pid")), cell(s.at("uid")), cell(s.at("node")),
+                         cell(s.at("depth")), cell(s.at("transient_local")), cell(queue),
+                         cell(s.at("pending")), cell(s.at("unreceived")), cell(s.at("held")),
+                         cell(s.at("received")), cell(s.at("dropped"))});
   }
-  return "topic " + cell(value.at("name")) + "\n\npublishers\n" + publishers.render() +
-         "\nsubscribers\n" + subscribers.render();
+  return "topic " + cell(value.at("name")) + "\ntype  " + cell(value.at("type")) +
+         (value.at("type").is_null() ? std::string() : " (" + cell(value.at("type_hash")) + ")") +
+         "\n\npublishers\n" + publishers.render() + "\nsubscribers\n" + subscribers.render();
 }
 
 std::string topic_hz_table(const json& value) {

@@ -190,14 +190,17 @@ class CliLive : public ::testing::Test {
 TEST_F(CliLive, TopicList) {
   const Outcome r = cli("topic list --json");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(find_by(r.value()["topics"], "name", topic),
-            json({{"name", topic}, {"publishers", 1}, {"subscribers", 2}}));
+  EXPECT_EQ(find_by(r.value()["topics"], "name", topic), json({{"name", topic},
+                                                               {"type", "chatter/msg/Message"},
+                                                               {"publishers", 1},
+                                                               {"subscribers", 2}}));
 
   const Outcome table = cli("topic list");
   ASSERT_EQ(table.code, 0);
   EXPECT_EQ(words_of(lines_of(table.out).at(0)),
-            (std::vector<std::string>{"NAME", "PUBLISHERS", "SUBSCRIBERS"}));
-  EXPECT_EQ(row_starting(table.out, topic), (std::vector<std::string>{topic, "1", "2"}));
+            (std::vector<std::string>{"NAME", "TYPE", "PUBLISHERS", "SUBSCRIBERS"}));
+  EXPECT_EQ(row_starting(table.out, topic),
+            (std::vector<std::string>{topic, "chatter/msg/Message", "1", "2"}));
   expect_ends_under_header(table.out, "SUBSCRIBERS", line_containing(table.out, topic));
 }
 
@@ -206,6 +209,8 @@ TEST_F(CliLive, TopicInfo) {
   ASSERT_EQ(r.code, 0) << r.err;
   const json info = r.value();
   EXPECT_EQ(info["name"], topic);
+  EXPECT_EQ(info["type"], "chatter/msg/Message");
+  EXPECT_EQ(info["type_hash"].get<std::string>().size(), 16u);
   ASSERT_EQ(info["publishers"].size(), 1u);
   const json pub = info["publishers"][0];
   EXPECT_EQ(pub["pid"], talker);

@@ -1,27 +1,41 @@
-# Chooses the kernel the module is built for and the test VM boots:
-# KDIR (cache or environment) wins; otherwise the newest Debian kernel image
-# in /boot whose headers are installed.
+# The kernels the module is built for and the VM suite boots, as listed by
+# tests/vm/kernels (stock, rt, 6.12, debug: whichever is ready).  For each
+# name in AGNOCAST_KERNELS: AGNOCAST_KERNEL_<name>_RELEASE, _IMAGE and _KDIR.
+# KDIR (cache or environment) overrides the stock kernel's headers.  KDIR,
+# AGNOCAST_KERNEL_RELEASE and AGNOCAST_VM_KERNEL_IMAGE describe the stock
+# kernel, which the native build and the single-kernel tests use.
 set(KDIR "$ENV{KDIR}" CACHE PATH "Kernel build directory the module is built against")
 
-file(GLOB _agnocast_vmlinuz_candidates /boot/vmlinuz-*)
-list(SORT _agnocast_vmlinuz_candidates COMPARE NATURAL ORDER DESCENDING)
-set(AGNOCAST_KERNEL_RELEASE "")
-foreach(_image IN LISTS _agnocast_vmlinuz_candidates)
-  string(REGEX REPLACE "^/boot/vmlinuz-" "" _release "${_image}")
-  if(EXISTS "/usr/src/linux-headers-${_release}/Makefile")
-    set(AGNOCAST_KERNEL_RELEASE "${_release}")
-    break()
+execute_process(COMMAND "${PROJECT_SOURCE_DIR}/tests/vm/kernels" list
+                OUTPUT_VARIABLE _agnocast_kernel_lines RESULT_VARIABLE _agnocast_kernels_rc)
+if(NOT _agnocast_kernels_rc EQUAL 0)
+  message(FATAL_ERROR "tests/vm/kernels list failed")
+endif()
+set(AGNOCAST_KERNELS)
+string(REPLACE "\n" ";" _agnocast_kernel_lines "${_agnocast_kernel_lines}")
+foreach(_line IN LISTS _agnocast_kernel_lines)
+  if(_line STREQUAL "")
+    continue()
   endif()
+  string(REPLACE "\t" ";" _fields "${_line}")
+  list(GET _fields 0 _name)
+  list(GET _fields 1 AGNOCAST_KERNEL_${_name}_RELEASE)
+  list(GET _fields 2 AGNOCAST_KERNEL_${_name}_IMAGE)
+  list(GET _fields 3 AGNOCAST_KERNEL_${_name}_KDIR)
+  list(APPEND AGNOCAST_KERNELS ${_name})
 endforeach()
 
-if(NOT KDIR AND AGNOCAST_KERNEL_RELEASE)
-  set(KDIR "/usr/src/linux-headers-${AGNOCAST_KERNEL_RELEASE}" CACHE PATH
-      "Kernel build directory the module is built against" FORCE)
+set(AGNOCAST_KERNEL_RELEASE "")
+if("stock" IN_LIST AGNOCAST_KERNELS)
+  set(AGNOCAST_KERNEL_RELEASE "${AGNOCAST_KERNEL_stock_RELEASE}")
+  set(AGNOCAST_VM_KERNEL_IMAGE "${AGNOCAST_KERNEL_stock_IMAGE}")
+  if(NOT KDIR)
+    set(KDIR "${AGNOCAST_KERNEL_stock_KDIR}" CACHE PATH
+        "Kernel build directory the module is built against" FORCE)
+  endif()
+  set(AGNOCAST_KERNEL_stock_KDIR "${KDIR}")
 endif()
-if(AGNOCAST_KERNEL_RELEASE)
-  set(AGNOCAST_VM_KERNEL_IMAGE "/boot/vmlinuz-${AGNOCAST_KERNEL_RELEASE}")
-  set(AGNOCAST_VM_KERNEL_MODULES "/lib/modules/${AGNOCAST_KERNEL_RELEASE}")
-endif()
+message(STATUS "VM suite kernels: ${AGNOCAST_KERNELS}")
 
 if(NOT KDIR)
   message(WARNING "No kernel headers found: install linux-image-amd64 and "
@@ -29,12 +43,17 @@ if(NOT KDIR)
                   "The module and the VM suite are skipped.")
 endif()
 
-# agnocast_add_kernel_module(TARGET name SOURCE_DIR dir)
+# agnocast_add_kernel_module(TARGET name SOURCE_DIR dir MODULE_NAME name
+#                            [KDIR dir])
 # Builds the Kbuild module in SOURCE_DIR (its Kbuild file, *.c, *.h and
-# include/) out of tree against KDIR.  Sets <name>_KO in the caller's scope to
-# the resulting .ko and makes it the target's KO property.
+# include/) out of tree with W=1 against KDIR (default: the stock kernel's).
+# Sets <name>_KO in the caller's scope to the resulting .ko and makes it the
+# target's KO property.
 function(agnocast_add_kernel_module)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "TARGET;SOURCE_DIR;MODULE_NAME" "")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "TARGET;SOURCE_DIR;MODULE_NAME;KDIR" "")
+  if(NOT arg_KDIR)
+    set(arg_KDIR "${KDIR}")
+  endif()
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS
        "${arg_SOURCE_DIR}/*.c" "${arg_SOURCE_DIR}/*.h" "${arg_SOURCE_DIR}/Kbuild")
   list(FILTER sources EXCLUDE REGEX "/tests/")
@@ -45,9 +64,9 @@ function(agnocast_add_kernel_module)
     COMMAND ${CMAKE_COMMAND} -E rm -rf "${build_dir}"
     COMMAND ${CMAKE_COMMAND} -E copy_directory "${arg_SOURCE_DIR}" "${build_dir}"
     COMMAND ${CMAKE_COMMAND} -E rm -rf "${build_dir}/tests"
-    COMMAND make -C "${KDIR}" "M=${build_dir}" W=1 modules
+    COMMAND make -C "${arg_KDIR}" "M=${build_dir}" W=1 modules
     DEPENDS ${sources}
-    COMMENT "Building ${arg_MODULE_NAME}.ko against ${KDIR}"
+    COMMENT "Building ${arg_MODULE_NAME}.ko against ${arg_KDIR}"
     VERBATIM)
   add_custom_target(${arg_TARGET} ALL DEPENDS "${ko}")
   set_target_properties(${arg_TARGET} PROPERTIES KO "${ko}")

@@ -19,7 +19,9 @@
  *
  * Locking order (outermost first):
  *   agnocast_ns_list_lock -> agnocast_ns.lock -> agnocast_proc_table_lock
- * The table lock is a spinlock because the exit probe cannot sleep.
+ * The table lock is a raw spinlock because the exit probe runs with
+ * preemption disabled, where PREEMPT_RT's spinlock_t, a sleeping lock, must
+ * not be taken.
  */
 #include <linux/bitmap.h>
 #include <linux/cred.h>
@@ -38,7 +40,7 @@
 
 #include "agnocast_internal.h"
 
-static DEFINE_SPINLOCK(agnocast_proc_table_lock);
+static DEFINE_RAW_SPINLOCK(agnocast_proc_table_lock);
 static DEFINE_HASHTABLE(agnocast_proc_table, 10);
 static struct workqueue_struct *agnocast_wq;
 static struct tracepoint *agnocast_exit_tp;
@@ -83,9 +85,9 @@ static void agnocast_proc_teardown(struct agnocast_proc *proc, bool record)
 	struct agnocast_ns *ns = proc->ns;
 
 	lockdep_assert_held(&ns->lock);
-	spin_lock(&agnocast_proc_table_lock);
+	raw_spin_lock(&agnocast_proc_table_lock);
 	hash_del(&proc->table_node);
-	spin_unlock(&agnocast_proc_table_lock);
+	raw_spin_unlock(&agnocast_proc_table_lock);
 
 	if (record)
 		agnocast_queue_exit_records(proc);
@@ -129,13 +131,13 @@ static void agnocast_on_process_exit(void *data, struct task_struct *p)
 
 	if (atomic_read(&p->signal->live))
 		return;
-	spin_lock(&agnocast_proc_table_lock);
+	raw_spin_lock(&agnocast_proc_table_lock);
 	proc = agnocast_proc_lookup(p->tgid);
 	if (proc) {
 		proc->dying = true;
 		queue_work(agnocast_wq, &proc->teardown_work);
 	}
-	spin_unlock(&agnocast_proc_table_lock);
+	raw_spin_unlock(&agnocast_proc_table_lock);
 }
 
 static void agnocast_find_exit_tp(struct tracepoint *tp, void *priv)
@@ -191,7 +193,7 @@ int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool r
 		return -ENOMEM;
 	mutex_lock(&ctx->ns->lock);
 
-	spin_lock(&agnocast_proc_table_lock);
+	raw_spin_lock(&agnocast_proc_table_lock);
 	proc = agnocast_proc_lookup(current->tgid);
 	if (proc && proc->ns != ctx->ns) {
 		other_ns = true;
@@ -201,7 +203,7 @@ int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool r
 	} else {
 		ctx->proc = proc;
 	}
-	spin_unlock(&agnocast_proc_table_lock);
+	raw_spin_unlock(&agnocast_proc_table_lock);
 
 	if (stale)
 		agnocast_proc_teardown(stale, true);
@@ -257,9 +259,9 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 	list_add_tail(&proc->ns_node, &ns->procs);
 	ns->nr_procs++;
 
-	spin_lock(&agnocast_proc_table_lock);
+	raw_spin_lock(&agnocast_proc_table_lock);
 	hash_add(agnocast_proc_table, &proc->table_node, proc->tgid);
-	spin_unlock(&agnocast_proc_table_lock);
+	raw_spin_unlock(&agnocast_proc_table_lock);
 	*err = 0;
 	return proc;
 
@@ -317,9 +319,9 @@ int agnocast_unregister_process(struct agnocast_ns *file_ns)
 	ret = agnocast_enter(&ctx, file_ns, true);
 	if (ret)
 		return ret;
-	spin_lock(&agnocast_proc_table_lock);
+	raw_spin_lock(&agnocast_proc_table_lock);
 	ctx.proc->dying = true;
-	spin_unlock(&agnocast_proc_table_lock);
+	raw_spin_unlock(&agnocast_proc_table_lock);
 	agnocast_proc_teardown(ctx.proc, false);
 	agnocast_leave(&ctx);
 	return 0;

@@ -64,7 +64,8 @@ function(agnocast_add_kernel_module)
     COMMAND ${CMAKE_COMMAND} -E rm -rf "${build_dir}"
     COMMAND ${CMAKE_COMMAND} -E copy_directory "${arg_SOURCE_DIR}" "${build_dir}"
     COMMAND ${CMAKE_COMMAND} -E rm -rf "${build_dir}/tests"
-    COMMAND make -C "${arg_KDIR}" "M=${build_dir}" W=1 modules
+    COMMAND make -C "${arg_KDIR}" "M=${build_dir}" W=1
+            "AGNOCAST_WERROR=$<BOOL:${AGNOCAST_WERROR}>" modules
     DEPENDS ${sources}
     COMMENT "Building ${arg_MODULE_NAME}.ko against ${arg_KDIR}"
     VERBATIM)

@@ -230,24 +230,30 @@ TEST_F(CliLive, TopicInfo) {
   EXPECT_EQ(frozen["pending"], 10);  // a full queue: the talker never blocks on it
   EXPECT_EQ(frozen["unreceived"], 10);
   EXPECT_GT(frozen["dropped"].get<int>(), 0);
+  EXPECT_EQ(live["uid"], 0);
+  EXPECT_EQ(live["polling"], false);
+  EXPECT_GT(live["received"].get<int>(), 0);
+  EXPECT_EQ(frozen["received"], 0);
   for (const json& s : info["subscribers"]) {
-    EXPECT_EQ(s.size(), 8u) << s.dump();
+    EXPECT_EQ(s.size(), 13u) << s.dump();
   }
 
   const Outcome table = cli("topic info " + topic);
   ASSERT_EQ(table.code, 0);
   EXPECT_EQ(lines_of(table.out).at(0), "topic " + topic);
+  EXPECT_EQ(lines_of(table.out).at(1).rfind("type  chatter/msg/Message (", 0), 0u) << table.out;
   const auto talker_row = row_starting(table.out, pub["id"].dump());
-  ASSERT_EQ(talker_row.size(), 6u) << table.out;
+  ASSERT_EQ(talker_row.size(), 7u) << table.out;
   EXPECT_EQ(talker_row[1], std::to_string(talker));
-  EXPECT_EQ(talker_row[2], "talker");
+  EXPECT_EQ(talker_row[2], "0");
+  EXPECT_EQ(talker_row[3], "talker");
   const auto frozen_row = row_starting(table.out, frozen["id"].dump());
-  ASSERT_EQ(frozen_row.size(), 8u) << table.out;
+  ASSERT_EQ(frozen_row.size(), 12u) << table.out;
   EXPECT_EQ(frozen_row[1], std::to_string(stopped));
-  EXPECT_EQ(frozen_row[4], frozen["queue"]);
-  EXPECT_EQ(frozen_row[5], "10");
-  EXPECT_EQ(frozen_row[6], "10");
-  EXPECT_NE(table.out.find("PENDING  UNRECEIVED  DROPPED"), std::string::npos);
+  EXPECT_EQ(frozen_row[6], frozen["queue"]);
+  EXPECT_EQ(frozen_row[7], "10");
+  EXPECT_EQ(frozen_row[8], "10");
+  EXPECT_NE(table.out.find("PENDING  UNRECEIVED  HELD  RECEIVED  DROPPED"), std::string::npos);
 }
 
 TEST_F(CliLive, TopicHzMeasuresWithoutSubscribing) {

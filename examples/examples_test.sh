@@ -17,6 +17,22 @@ agnocast-talker --topic "$topic" --count 20 --depth 20 --rate 0 --size 100000
 wait "$listener"
 cat listener.json
 grep -qx '{"received":20,"corrupt":0,"first_seq":0,"last_seq":19,"missed":0,"max_size":100000}' listener.json
+# --count stops at exactly that many, even when wake-ups deliver batches.
+wait_subscribed() {
+  tries=0
+  until ls /dev/mqueue | grep -q "^$1@"; do
+    tries=$((tries + 1))
+    [ "$tries" -lt 200 ] || { echo "listener never subscribed"; exit 1; }
+    sleep 0.05
+  done
+}
+agnocast-listener --topic "${topic}_batch" --count 5 --depth 200 --timeout 60 --json >batch.json &
+listener=$!
+wait_subscribed "${mangled}_batch"
+agnocast-talker --topic "${topic}_batch" --count 200 --depth 200 --rate 0 --size 64
+wait "$listener"
+cat batch.json
+grep -qx '{"received":5,"corrupt":0,"first_seq":0,"last_seq":4,"missed":0,"max_size":64}' batch.json
 # A timeout exits 1 with the summary still printed.
 if agnocast-listener --topic "$topic" --count 1 --timeout 1 --json >timeout.json; then
   echo "listener should fail on timeout"; exit 1

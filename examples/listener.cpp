@@ -82,7 +82,8 @@ int main(int argc, char** argv) {
     if (transient_local) qos.transient_local();
     auto subscription = node.create_subscription<chatter::Message>(
         topic, qos, [&](const agnocast::ipc_shared_ptr<const chatter::Message>& message) {
-          summary.record(*message);
+          // One wake-up may deliver a whole batch: stop counting at exactly --count.
+          if (count == 0 || summary.received < count) summary.record(*message);
         });
     agnocast::SingleThreadedExecutor executor;
     executor.add_node(node);

@@ -37,6 +37,41 @@ int run_chosen(const Command& command, bool json, std::ostream& out, std::ostrea
   return command.exit_code ? command.exit_code(value) : exit_success;
 }
 
+std::string command_names(const std::vector<CLI::App*>& commands) {
+  std::string names;
+  for (const CLI::App* command : commands) {
+    if (!names.empty()) names += ", ";
+    names += command->get_name();
+  }
+  return names;
+}
+
+// For a failed parse: the first word that is no command of the command it
+// follows, or a command given without the command it needs, with the valid
+// ones; empty when the commands are right (an option or argument is wrong).
+std::string command_problem(CLI::App& app, int argc, const char* const* argv) {
+  CLI::App* current = &app;
+  std::string path = app.get_name();
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.starts_with("-")) continue;
+    const std::vector<CLI::App*> commands = current->get_subcommands({});
+    if (commands.empty()) return {};  // a leaf: the rest are its arguments
+    const auto match = std::find_if(commands.begin(), commands.end(), [&](const CLI::App* command) {
+      return command->check_name(word);
+    });
+    if (match == commands.end()) {
+      return "unknown command '" + word + "' for '" + path +
+             "'; valid commands: " + command_names(commands);
+    }
+    current = *match;
+    path += " " + current->get_name();
+  }
+  const std::vector<CLI::App*> commands = current->get_subcommands({});
+  if (commands.empty()) return {};
+  return "'" + path + "' needs a command: " + command_names(commands);
+}
+
 }  // namespace
 
 void add_json_flag(CLI::App& app, Context& context) {
@@ -68,8 +103,10 @@ int run_cli(int argc, const char* const* argv, InspectionSource& source, std::os
   } catch (const CLI::Success& e) {  // --help
     return app.exit(e, out, err);
   } catch (const CLI::ParseError& e) {
-    return fail(exit_usage_error, e.what() + std::string("; see --help"), wants_json(argc, argv),
-                out, err);
+    const std::string unknown = command_problem(app, argc, argv);
+    return fail(exit_usage_error,
+                (unknown.empty() ? e.what() : unknown) + std::string("; see --help"),
+                wants_json(argc, argv), out, err);
   }
   if (!context.chosen) {
     return fail(exit_usage_error, "no command given; see --help", context.json, out, err);

@@ -82,6 +82,29 @@ TEST(Cli, UsageErrorsExitTwo) {
   }
 }
 
+TEST(Cli, AnUnknownCommandIsNamedWithTheValidOnes) {
+  FakeSource source = healthy_system();
+  Outcome r = run(source, {"frobnicate"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown command 'frobnicate' for 'agnocast-cli'; valid commands: topic, "
+                       "queue, node, daemon, doctor, policy, version"),
+            std::string::npos)
+      << r.err;
+  r = run(source, {"--json", "topic", "lsit"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(
+      r.err.find(
+          "unknown command 'lsit' for 'agnocast-cli topic'; valid commands: list, info, hz, echo"),
+      std::string::npos)
+      << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["exit_code"], 2);
+  r = run(source, {"topic"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("'agnocast-cli topic' needs a command: list, info, hz, echo"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST(Cli, UsageErrorWithJsonPrintsAnErrorObject) {
   FakeSource source = healthy_system();
   const Outcome r = run(source, {"--json", "topic", "info"});

@@ -72,6 +72,21 @@ std::string command_problem(CLI::App& app, int argc, const char* const* argv) {
   return "'" + path + "' needs a command: " + command_names(commands);
 }
 
+// `agnocast-cli --version` is the `version` command: the flag becomes the
+// command's name when it comes before any command.
+std::vector<const char*> with_version_flag_as_command(int argc, const char* const* argv) {
+  std::vector<const char*> args(argv, argv + argc);
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string_view arg = args[i];
+    if (arg == "--version") {
+      args[i] = "version";
+      break;
+    }
+    if (!arg.starts_with("-")) break;  // a command: --version is its option, if any
+  }
+  return args;
+}
+
 }  // namespace
 
 void add_json_flag(CLI::App& app, Context& context) {
@@ -83,8 +98,10 @@ void bind_command(CLI::App& sub, Context& context, Command command) {
   sub.callback([&context, command = std::move(command)] { context.chosen = command; });
 }
 
-int run_cli(int argc, const char* const* argv, InspectionSource& source, std::ostream& out,
+int run_cli(int argc, const char* const* argv_given, InspectionSource& source, std::ostream& out,
             std::ostream& err) {
+  const std::vector<const char*> args = with_version_flag_as_command(argc, argv_given);
+  const char* const* argv = args.data();
   Context context{source, false, std::nullopt};
   CLI::App app{"agnocast-cli: inspect agnocast topics, queues, nodes and the daemon",
                "agnocast-cli"};
@@ -97,6 +114,8 @@ int run_cli(int argc, const char* const* argv, InspectionSource& source, std::os
   set_doctor_command(app, context);
   set_policy_command(app, context);
   set_version_command(app, context);
+  // Shown in --help; run_cli turns it into the version command before parsing.
+  app.add_flag("--version")->description("Same as the version command");
 
   try {
     app.parse(argc, argv);

@@ -105,6 +105,16 @@ TEST(Cli, AnUnknownCommandIsNamedWithTheValidOnes) {
       << r.err;
 }
 
+TEST(Cli, VersionFlagIsTheVersionCommand) {
+  FakeSource source = healthy_system();
+  const Outcome command = run(source, {"version", "--json"});
+  const Outcome flag = run(source, {"--version", "--json"});
+  EXPECT_EQ(flag.code, 0) << flag.err;
+  EXPECT_EQ(flag.out, command.out);
+  EXPECT_EQ(run(source, {"--json", "--version"}).out, command.out);
+  EXPECT_EQ(run(source, {"--version"}).out, run(source, {"version"}).out);
+}
+
 TEST(Cli, UsageErrorWithJsonPrintsAnErrorObject) {
   FakeSource source = healthy_system();
   const Outcome r = run(source, {"--json", "topic", "info"});

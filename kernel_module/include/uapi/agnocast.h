@@ -353,8 +353,8 @@ struct agnocast_policy_rule {
  *            name, an unknown match/kind/flag, principals out of range, or an
  *            id that does not map into the caller's user namespace
  *
- * AGNOCAST_IOC_GET_POLICY: anyone.  in: capacities in rule_count and
- * principal_count (arrays may be 0 with capacity 0).  out: the policy's
+ * AGNOCAST_IOC_GET_POLICY: anyone.  in: flags 0; capacities in rule_count
+ * and principal_count (arrays may be 0 with capacity 0).  out: the policy's
  * flags and its total counts; the arrays are filled when they fit, else
  * -ENOSPC (call again with the totals).
  */

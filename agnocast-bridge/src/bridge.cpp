@@ -185,11 +185,11 @@ void write_status(const Config& config, const std::vector<BridgedTopic>& topics,
 }
 
 int serve(const Config& config, const TypeRegistry& types) {
+  DdsDomain domain(config.domain_id);
   const InstanceLock lock{std::string(lock_path)};
   agnocast::install_signal_handlers();
   const auto started_at = static_cast<std::int64_t>(std::time(nullptr));
 
-  DdsDomain domain(config.domain_id);
   agnocast::Node node(node_name);
   OwnPool own_pool;
   std::vector<BridgedTopic> topics;

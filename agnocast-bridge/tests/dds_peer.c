@@ -7,8 +7,8 @@
  *   dds-peer send-cloud TOPIC BYTES COUNT
  *   dds-peer recv-cloud TOPIC BYTES COUNT TIMEOUT_S
  *
- * A sender waits until a reader matched, sends, and waits for every
- * acknowledgement. A receiver prints "@ready" once a writer matched, checks
+ * A sender waits until a reader matched (DDS_PEER_MATCH readers, if set), sends,
+ * and waits for every acknowledgement. A receiver prints "@ready" once a writer matched, checks
  * every field of every sample, and (recv-twist) waits QUIET_S more seconds for
  * samples that should not come; it exits 0 only when each of COUNT messages
  * arrived exactly once with the values sent. */
@@ -39,7 +39,10 @@ static dds_qos_t* reliable_qos(int32_t depth) {
   return qos;
 }
 
+/* Waits until DDS_PEER_MATCH (default 1) endpoints of the other kind matched. */
 static int wait_matched(dds_entity_t entity, int writer, double timeout_s) {
+  const char* wanted_text = getenv("DDS_PEER_MATCH");
+  const uint32_t wanted = wanted_text ? (uint32_t)atoi(wanted_text) : 1;
   const dds_time_t deadline = now() + (dds_time_t)(timeout_s * 1e9);
   while (now() < deadline) {
     uint32_t count = 0;
@@ -50,7 +53,7 @@ static int wait_matched(dds_entity_t entity, int writer, double timeout_s) {
       dds_subscription_matched_status_t status;
       if (dds_get_subscription_matched_status(entity, &status) == 0) count = status.current_count;
     }
-    if (count > 0) return 0;
+    if (count >= wanted) return 0;
     dds_sleepfor(DDS_MSECS(20));
   }
   fprintf(stderr, "dds-peer: nothing matched within %.0f s\n", timeout_s);

@@ -101,8 +101,8 @@ static int send_twist(dds_entity_t participant, const char* topic, uint32_t coun
   return 0;
 }
 
-static int recv_twist(dds_entity_t participant, const char* topic, uint32_t count,
-                      double timeout_s, double quiet_s) {
+static int recv_twist(dds_entity_t participant, const char* topic, uint32_t count, double timeout_s,
+                      double quiet_s) {
   const dds_entity_t reader =
       make_endpoint(participant, topic, &geometry_msgs_msg_dds__Twist__desc, 0, 0);
   if (reader < 0) return fail("reader", reader);
@@ -192,8 +192,7 @@ static int cloud_matches(const sensor_msgs_msg_dds__PointCloud2_* c, uint32_t by
   return 1;
 }
 
-static int send_cloud(dds_entity_t participant, const char* topic, uint32_t bytes,
-                      uint32_t count) {
+static int send_cloud(dds_entity_t participant, const char* topic, uint32_t bytes, uint32_t count) {
   const dds_entity_t writer =
       make_endpoint(participant, topic, &sensor_msgs_msg_dds__PointCloud2__desc, 1, 0);
   if (writer < 0) return fail("writer", writer);
@@ -211,8 +210,8 @@ static int send_cloud(dds_entity_t participant, const char* topic, uint32_t byte
   return 0;
 }
 
-static int recv_cloud(dds_entity_t participant, const char* topic, uint32_t bytes,
-                      uint32_t count, double timeout_s) {
+static int recv_cloud(dds_entity_t participant, const char* topic, uint32_t bytes, uint32_t count,
+                      double timeout_s) {
   const dds_entity_t reader =
       make_endpoint(participant, topic, &sensor_msgs_msg_dds__PointCloud2__desc, 0, (int32_t)count);
   if (reader < 0) return fail("reader", reader);

@@ -102,25 +102,6 @@ struct Executor::State {
     }
   }
 
-  // One-shot descriptors wait for this after each handling, even when a
-  // callback threw, or the waitable would go deaf.
-  void rearm(const detail::Waitable& waitable) const {
-    if (!(waitable_events & EPOLLONESHOT)) return;
-    epoll_event event{};
-    event.events = waitable_events;
-    event.data.u64 = waitable.key();
-    ::epoll_ctl(epoll_fd, EPOLL_CTL_MOD, waitable.wait_fd(), &event);
-  }
-
-  void execute_and_rearm(detail::Waitable& waitable) const {
-    struct Rearm {
-      const State& state;
-      const detail::Waitable& waitable;
-      ~Rearm() { state.rearm(waitable); }
-    } rearm{*this, waitable};
-    waitable.execute();
-  }
-
   std::shared_ptr<detail::Waitable> find(std::uint64_t key) {
     std::lock_guard lock(mutex);
     if (auto found = armed.find(key); found != armed.end()) return found->second.lock();
@@ -135,7 +116,7 @@ struct Executor::State {
     }
     std::shared_ptr<detail::Waitable> waitable = find(key);
     if (!waitable) return Outcome::idle;
-    run_in_group(*this, std::move(waitable));
+    run_in_group(detail::PendingWork{std::move(waitable), epoll_fd, waitable_events});
     return Outcome::handled;
   }
 
@@ -160,34 +141,56 @@ struct Executor::State {
   std::map<int, std::shared_ptr<FdWaitable>> fds;  // what add_fd() added, by descriptor
 };
 
-void Executor::run_in_group(State& state, std::shared_ptr<detail::Waitable> waitable) {
-  CallbackGroup& group = *waitable->group();
+namespace {
+
+// One-shot descriptors wait again only once re-armed, which happens after
+// each handling even when a callback threw, or the waitable would go deaf.
+void rearm(const detail::PendingWork& work) {
+  if (!(work.events & EPOLLONESHOT)) return;
+  epoll_event event{};
+  event.events = work.events;
+  event.data.u64 = work.waitable->key();
+  ::epoll_ctl(work.epoll_fd, EPOLL_CTL_MOD, work.waitable->wait_fd(), &event);
+}
+
+void execute_and_rearm(const detail::PendingWork& work) {
+  struct Rearm {
+    const detail::PendingWork& work;
+    ~Rearm() { rearm(work); }
+  } rearm_on_exit{work};
+  work.waitable->execute();
+}
+
+}  // namespace
+
+void Executor::run_in_group(detail::PendingWork work) {
+  CallbackGroup& group = *work.waitable->group();
   if (group.type() == CallbackGroupType::Reentrant) {
-    state.execute_and_rearm(*waitable);
+    execute_and_rearm(work);
     return;
   }
   {
     std::lock_guard lock(group.mutex_);
     if (group.running_) {
       // Still disarmed (one-shot): the running thread executes and re-arms it.
-      group.pending_.push_back(std::move(waitable));
+      group.pending_.push_back(std::move(work));
       return;
     }
     group.running_ = true;
   }
   for (;;) {
     try {
-      state.execute_and_rearm(*waitable);
+      execute_and_rearm(work);
     } catch (...) {
       // Hand the group back; what waited is re-armed and fires again, as its
       // descriptor is still readable.
-      std::deque<std::shared_ptr<detail::Waitable>> left;
+      std::deque<detail::PendingWork> left;
       {
         std::lock_guard lock(group.mutex_);
         group.running_ = false;
         left.swap(group.pending_);
       }
-      for (const auto& pending : left) state.rearm(*pending);
+      for (const auto& pending : left) rearm(pending);
       throw;
     }
     std::lock_guard lock(group.mutex_);
@@ -195,7 +198,7 @@ void Executor::run_in_group(State& state, std::shared_ptr<detail::Waitable> wait
       group.running_ = false;
       return;
     }
-    waitable = std::move(group.pending_.front());
+    work = std::move(group.pending_.front());
     group.pending_.pop_front();
   }
 }

@@ -216,6 +216,39 @@ TEST_F(ExecutorTest, ExclusiveGroupsRunInParallelWithEachOther) {
   spinner.join();
 }
 
+TEST_F(ExecutorTest, AGroupSharedByTwoExecutorsKeepsBothAwake) {
+  Node first_node{"first"}, second_node{"second"};
+  auto group = first_node.create_callback_group(CallbackGroupType::MutuallyExclusive);
+  Overlap overlap;
+  std::atomic<int> first_runs{0}, second_runs{0};
+  auto first = first_node.create_wall_timer(
+      1ms,
+      [&] {
+        overlap.run(1ms);
+        ++first_runs;
+      },
+      group);
+  auto second = second_node.create_wall_timer(
+      1ms,
+      [&] {
+        overlap.run(1ms);
+        ++second_runs;
+      },
+      group);
+  MultiThreadedExecutor first_executor(2), second_executor(2);
+  first_executor.add_node(first_node);
+  second_executor.add_node(second_node);
+  std::thread first_spinner([&] { first_executor.spin(); });
+  std::thread second_spinner([&] { second_executor.spin(); });
+  // Work one executor's thread ran for the other is re-armed in the other's epoll set.
+  EXPECT_TRUE(eventually([&] { return first_runs >= 50 && second_runs >= 50; }));
+  first_executor.cancel();
+  second_executor.cancel();
+  first_spinner.join();
+  second_spinner.join();
+  EXPECT_EQ(overlap.most.load(), 1);
+}
+
 TEST_F(ExecutorTest, AnAddedDescriptorRunsItsCallbackWhenReadable) {
   const int fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   ASSERT_GE(fd, 0);

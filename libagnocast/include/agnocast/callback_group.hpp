@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -8,7 +9,15 @@ namespace agnocast {
 
 namespace detail {
 class Waitable;
-}
+
+// Ready work a busy MutuallyExclusive group keeps for the thread running it,
+// with the executor's epoll set to re-arm it in afterwards.
+struct PendingWork {
+  std::shared_ptr<Waitable> waitable;
+  int epoll_fd = -1;
+  std::uint32_t events = 0;
+};
+}  // namespace detail
 
 enum class CallbackGroupType {
   // One callback of the group at a time, whatever the executor's threads.
@@ -36,7 +45,7 @@ class CallbackGroup {
   // others leave their ready callbacks in `pending` for it.
   std::mutex mutex_;
   bool running_ = false;
-  std::deque<std::shared_ptr<detail::Waitable>> pending_;
+  std::deque<detail::PendingWork> pending_;
 };
 
 }  // namespace agnocast

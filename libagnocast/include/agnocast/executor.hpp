@@ -53,7 +53,7 @@ class Executor {
   // Runs waitable within its callback group's rule: one at a time for a
   // MutuallyExclusive group (a thread finding the group busy leaves the work
   // to the thread running it), freely for a Reentrant one.
-  static void run_in_group(State& state, std::shared_ptr<detail::Waitable> waitable);
+  static void run_in_group(detail::PendingWork work);
 
   std::unique_ptr<State> state_;
 };

@@ -276,6 +276,13 @@ static void agnocast_sub_push(struct agnocast_subscriber *sub, struct agnocast_m
 	msg->refs++;
 }
 
+/* AGNOCAST_IGNORE_LOCAL: the subscriber never gets its own process's entries. */
+static bool agnocast_sub_ignores(const struct agnocast_subscriber *sub,
+				 const struct agnocast_publisher *pub)
+{
+	return (sub->flags & AGNOCAST_IGNORE_LOCAL) && sub->proc == pub->proc;
+}
+
 /* Transient local: the newest entries still in transient-local windows. */
 static void agnocast_sub_fill_transient(struct agnocast_subscriber *sub)
 {
@@ -286,14 +293,16 @@ static void agnocast_sub_fill_transient(struct agnocast_subscriber *sub)
 	list_for_each_entry_reverse(msg, &topic->entries, node) {
 		if (n == sub->depth)
 			break;
-		if (msg->publisher && (msg->publisher->flags & AGNOCAST_TRANSIENT_LOCAL))
+		if (msg->publisher && (msg->publisher->flags & AGNOCAST_TRANSIENT_LOCAL) &&
+		    !agnocast_sub_ignores(sub, msg->publisher))
 			n++;
 	}
 	i = n;
 	list_for_each_entry_reverse(msg, &topic->entries, node) {
 		if (!i)
 			break;
-		if (msg->publisher && (msg->publisher->flags & AGNOCAST_TRANSIENT_LOCAL)) {
+		if (msg->publisher && (msg->publisher->flags & AGNOCAST_TRANSIENT_LOCAL) &&
+		    !agnocast_sub_ignores(sub, msg->publisher)) {
 			sub->unreceived[--i] = msg;
 			msg->refs++;
 		}
@@ -426,14 +435,14 @@ static bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg
 		return false;
 	if (!arg->depth || arg->depth > AGNOCAST_DEPTH_MAX)
 		return false;
-	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING))
+	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL))
 		return false;
 	if (!agnocast_str_terminated(arg->type_name, sizeof(arg->type_name)) ||
 	    !agnocast_type_name_valid(arg->type_name))
 		return false;
 	if (arg->schema_size > AGNOCAST_SCHEMA_MAX || arg->reserved)
 		return false;
-	return !(publisher && (arg->flags & AGNOCAST_POLLING));
+	return !(publisher && (arg->flags & (AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL)));
 }
 
 /*
@@ -753,7 +762,7 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	/* The wake list is known before committing; write it first. */
 	wake_ids = u64_to_user_ptr(arg.wake_ids);
 	list_for_each_entry(sub, &topic->subscribers, topic_node) {
-		if (sub->flags & AGNOCAST_POLLING)
+		if ((sub->flags & AGNOCAST_POLLING) || agnocast_sub_ignores(sub, pub))
 			continue;
 		if (put_user(sub->id, wake_ids + wake_count)) {
 			agnocast_msg_free(ctx.proc, msg);
@@ -778,7 +787,8 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	pub->published++;
 	pub->published_bytes += arg.bytes;
 	list_for_each_entry(sub, &topic->subscribers, topic_node)
-		agnocast_sub_push(sub, msg);
+		if (!agnocast_sub_ignores(sub, pub))
+			agnocast_sub_push(sub, msg);
 	arg.entry_id = msg->id;
 	if (pub->window_len > pub->depth)
 		agnocast_msg_leave_window(list_first_entry(&pub->window, struct agnocast_msg,

@@ -384,9 +384,11 @@ TEST_F(Device, AddEndpointRejectsBadInput) {
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
   ep = endpoint("/ok", AGNOCAST_DEPTH_MAX + 1);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);
-  ep = endpoint("/ok", 1, 1u << 2);
+  ep = endpoint("/ok", 1, 1u << 3);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep), -EINVAL);
   ep = endpoint("/ok", 1, AGNOCAST_POLLING);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
+  ep = endpoint("/ok", 1, AGNOCAST_IGNORE_LOCAL);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), -EINVAL);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, static_cast<agnocast_add_endpoint*>(kBadPtr)),
             -EFAULT);
@@ -552,6 +554,66 @@ TEST_F(Device, PublishReceiveRelease) {
   ASSERT_EQ(topic_info(dev, "/pr", &info, &pubs, &subs), 0);
   EXPECT_EQ(subs[1].dropped, 1u);
   EXPECT_EQ(subs[1].unreceived, 2u);
+}
+
+// A subscriber with IGNORE_LOCAL never queues, wakes for or is given as
+// history the entries of its own process; another process's reach it.
+TEST_F(Device, IgnoreLocalSkipsOnlyTheOwnProcesssEntries) {
+  registered();
+  Endpoint pub, plain, ignoring, ignoring_poll, late;
+  ASSERT_EQ(add_publisher(dev, "/il", 4, &pub, AGNOCAST_TRANSIENT_LOCAL), 0);
+  ASSERT_EQ(add_subscriber(dev, "/il", 4, &plain), 0);
+  ASSERT_EQ(add_subscriber(dev, "/il", 4, &ignoring, AGNOCAST_IGNORE_LOCAL), 0);
+  ASSERT_EQ(add_subscriber(dev, "/il", 4, &ignoring_poll, AGNOCAST_IGNORE_LOCAL | AGNOCAST_POLLING),
+            0);
+
+  PublishResult res;
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64, &res), 0);
+  ASSERT_EQ(res.wake.size(), 1u);
+  EXPECT_EQ(res.wake[0], plain.id);
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, ignoring, &rr), 0);
+  EXPECT_TRUE(rr.entries.empty());
+  ASSERT_EQ(add_subscriber(dev, "/il", 4, &late, AGNOCAST_IGNORE_LOCAL | AGNOCAST_TRANSIENT_LOCAL),
+            0);
+
+  int published[2];
+  ASSERT_EQ(pipe(published), 0);
+  const pid_t child = fork();
+  if (child == 0) {
+    const int d = open_device();
+    Registration r;
+    Endpoint other;
+    if (r.full(d) || add_publisher(d, "/il", 4, &other)) _exit(10);
+    PublishResult child_res;
+    if (publish(d, other, r.addr + 64, &child_res)) _exit(11);
+    // Woken: the plain and the ignoring callback subscribers of the parent.
+    if (child_res.wake.size() != 3u) _exit(12);
+    if (write(published[1], "x", 1) != 1) _exit(13);
+    pause();
+  }
+  close(published[1]);
+  char byte;
+  ASSERT_EQ(read(published[0], &byte, 1), 1) << "the child failed";
+  close(published[0]);
+
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  ASSERT_EQ(topic_info(dev, "/il", &info, nullptr, &subs), 0);
+  ASSERT_EQ(subs.size(), 4u);
+  EXPECT_EQ(subs[0].unreceived, 2u);  // plain: both
+  EXPECT_EQ(subs[1].unreceived, 1u);  // ignoring: only the child's
+  EXPECT_EQ(subs[2].unreceived, 1u);
+  EXPECT_EQ(subs[2].flags, static_cast<uint32_t>(AGNOCAST_IGNORE_LOCAL | AGNOCAST_POLLING));
+  EXPECT_EQ(subs[3].unreceived, 1u);  // no history from its own transient-local publisher
+  ASSERT_EQ(receive(dev, ignoring, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  EXPECT_NE(rr.entries[0].publisher_id, pub.id);
+  for (const auto& grant : rr.pools) close(grant.fd);
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  ASSERT_TRUE(eventually([&] { return !process_listed(dev, child); }));
+  drain_exit_records(dev);
 }
 
 // Freed entries and held records are reused (up to 16 per process), and a

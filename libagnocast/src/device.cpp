@@ -113,7 +113,8 @@ agnocast_add_endpoint to_uapi(const EndpointRequest& request) {
   argument.schema_size = static_cast<std::uint32_t>(request.schema.size());
   argument.depth = request.depth;
   argument.flags = (request.transient_local ? AGNOCAST_TRANSIENT_LOCAL : 0U) |
-                   (request.polling ? AGNOCAST_POLLING : 0U);
+                   (request.polling ? AGNOCAST_POLLING : 0U) |
+                   (request.ignore_local ? AGNOCAST_IGNORE_LOCAL : 0U);
   return argument;
 }
 

@@ -22,6 +22,7 @@ struct EndpointRequest {
   std::uint32_t depth = 1;
   bool transient_local = false;
   bool polling = false;
+  bool ignore_local = false;  // subscribers: skip messages of this process (kernel-filtered)
   // The message type: the topic's must be the same (TypeMismatch otherwise).
   std::string type_name;
   std::uint64_t type_hash = 0;

@@ -5,12 +5,15 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <deque>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -22,7 +25,7 @@
 namespace agnocast {
 namespace {
 
-// epoll keys besides subscription keys (which count up from 1).
+// epoll keys besides waitable keys (which count up from 1).
 constexpr std::uint64_t shutdown_key = ~std::uint64_t{0};
 constexpr std::uint64_t cancel_key = shutdown_key - 1;
 constexpr std::uint64_t change_key = shutdown_key - 2;
@@ -47,13 +50,26 @@ void watch(int epoll_fd, int fd, std::uint64_t key, std::uint32_t events, int op
   }
 }
 
+// A descriptor added with add_fd(): the executor holds it, not a node.
+class FdWaitable : public detail::Waitable {
+ public:
+  FdWaitable(int fd, std::function<void()> on_ready, std::shared_ptr<CallbackGroup> group)
+      : Waitable(std::move(group)), fd_(fd), on_ready_(std::move(on_ready)) {}
+  int wait_fd() const override { return fd_; }
+  void execute() override { on_ready_(); }
+
+ private:
+  const int fd_;
+  const std::function<void()> on_ready_;
+};
+
 }  // namespace
 
 struct Executor::State {
   enum class Outcome { handled, idle, stop };
 
   explicit State(bool parallel)
-      : subscription_events(parallel ? EPOLLIN | EPOLLONESHOT : EPOLLIN),
+      : waitable_events(parallel ? EPOLLIN | EPOLLONESHOT : EPOLLIN),
         epoll_fd(::epoll_create1(EPOLL_CLOEXEC)),
         cancel_fd(make_eventfd()),
         change_fd(make_eventfd()) {
@@ -70,21 +86,26 @@ struct Executor::State {
     ::close(change_fd);
   }
 
-  // Arms subscriptions the nodes gained and forgets destroyed ones (their
-  // closed queue descriptors have left the epoll set by themselves).
+  // Arms waitables the nodes gained and forgets destroyed ones (their
+  // closed descriptors have left the epoll set by themselves).
   void sync() {
     std::lock_guard lock(mutex);
     drain_eventfd(change_fd);
     std::erase_if(armed, [](const auto& entry) { return entry.second.expired(); });
     for (const auto& node : nodes) {
-      for (const auto& weak : node->subscriptions_snapshot()) {
-        const auto subscription = weak.lock();
-        if (!subscription || armed.contains(subscription->key())) continue;
-        watch(epoll_fd, subscription->queue_fd(), subscription->key(), subscription_events,
-              EPOLL_CTL_ADD);
-        armed.emplace(subscription->key(), weak);
+      for (const auto& weak : node->waitables_snapshot()) {
+        const auto waitable = weak.lock();
+        if (!waitable || armed.contains(waitable->key())) continue;
+        watch(epoll_fd, waitable->wait_fd(), waitable->key(), waitable_events, EPOLL_CTL_ADD);
+        armed.emplace(waitable->key(), weak);
       }
     }
+  }
+
+  std::shared_ptr<detail::Waitable> find(std::uint64_t key) {
+    std::lock_guard lock(mutex);
+    if (auto found = armed.find(key); found != armed.end()) return found->second.lock();
+    return nullptr;
   }
 
   Outcome handle(std::uint64_t key) {
@@ -93,26 +114,9 @@ struct Executor::State {
       sync();
       return Outcome::idle;
     }
-    std::shared_ptr<detail::SubscriptionBase> subscription;
-    {
-      std::lock_guard lock(mutex);
-      if (auto found = armed.find(key); found != armed.end()) subscription = found->second.lock();
-    }
-    if (!subscription) return Outcome::idle;
-    // Re-arm even when a callback throws, or the subscription would go deaf.
-    struct Rearm {
-      int epoll_fd;
-      std::uint32_t events;
-      const detail::SubscriptionBase& subscription;
-      ~Rearm() {
-        if (!(events & EPOLLONESHOT)) return;
-        epoll_event event{};
-        event.events = events;
-        event.data.u64 = subscription.key();
-        ::epoll_ctl(epoll_fd, EPOLL_CTL_MOD, subscription.queue_fd(), &event);
-      }
-    } rearm{epoll_fd, subscription_events, *subscription};
-    subscription->handle_wakeup();
+    std::shared_ptr<detail::Waitable> waitable = find(key);
+    if (!waitable) return Outcome::idle;
+    run_in_group(detail::PendingWork{std::move(waitable), epoll_fd, waitable_events});
     return Outcome::handled;
   }
 
@@ -127,14 +131,77 @@ struct Executor::State {
     return handle(event.data.u64);
   }
 
-  const std::uint32_t subscription_events;
+  const std::uint32_t waitable_events;
   const int epoll_fd;
   const int cancel_fd;
   const int change_fd;
-  std::mutex mutex;  // nodes and armed
+  std::mutex mutex;  // nodes, armed and fds
   std::vector<std::shared_ptr<detail::NodeState>> nodes;
-  std::map<std::uint64_t, std::weak_ptr<detail::SubscriptionBase>> armed;
+  std::map<std::uint64_t, std::weak_ptr<detail::Waitable>> armed;
+  std::map<int, std::shared_ptr<FdWaitable>> fds;  // what add_fd() added, by descriptor
 };
+
+namespace {
+
+// One-shot descriptors wait again only once re-armed, which happens after
+// each handling even when a callback threw, or the waitable would go deaf.
+void rearm(const detail::PendingWork& work) {
+  if (!(work.events & EPOLLONESHOT)) return;
+  epoll_event event{};
+  event.events = work.events;
+  event.data.u64 = work.waitable->key();
+  ::epoll_ctl(work.epoll_fd, EPOLL_CTL_MOD, work.waitable->wait_fd(), &event);
+}
+
+void execute_and_rearm(const detail::PendingWork& work) {
+  struct Rearm {
+    const detail::PendingWork& work;
+    ~Rearm() { rearm(work); }
+  } rearm_on_exit{work};
+  work.waitable->execute();
+}
+
+}  // namespace
+
+void Executor::run_in_group(detail::PendingWork work) {
+  CallbackGroup& group = *work.waitable->group();
+  if (group.type() == CallbackGroupType::Reentrant) {
+    execute_and_rearm(work);
+    return;
+  }
+  {
+    std::lock_guard lock(group.mutex_);
+    if (group.running_) {
+      // Still disarmed (one-shot): the running thread executes and re-arms it.
+      group.pending_.push_back(std::move(work));
+      return;
+    }
+    group.running_ = true;
+  }
+  for (;;) {
+    try {
+      execute_and_rearm(work);
+    } catch (...) {
+      // Hand the group back; what waited is re-armed and fires again, as its
+      // descriptor is still readable.
+      std::deque<detail::PendingWork> left;
+      {
+        std::lock_guard lock(group.mutex_);
+        group.running_ = false;
+        left.swap(group.pending_);
+      }
+      for (const auto& pending : left) rearm(pending);
+      throw;
+    }
+    std::lock_guard lock(group.mutex_);
+    if (group.pending_.empty()) {
+      group.running_ = false;
+      return;
+    }
+    work = std::move(group.pending_.front());
+    group.pending_.pop_front();
+  }
+}
 
 Executor::Executor(bool parallel) : state_(std::make_unique<State>(parallel)) {}
 Executor::~Executor() = default;
@@ -156,11 +223,34 @@ void Executor::remove_node(Node& node) {
   std::lock_guard lock(state_->mutex);
   std::erase(state_->nodes, node.state());
   node.state()->remove_watcher(state_->change_fd);
-  for (const auto& weak : node.state()->subscriptions_snapshot()) {
-    const auto subscription = weak.lock();
-    if (!subscription || !state_->armed.erase(subscription->key())) continue;
-    ::epoll_ctl(state_->epoll_fd, EPOLL_CTL_DEL, subscription->queue_fd(), nullptr);
+  for (const auto& weak : node.state()->waitables_snapshot()) {
+    const auto waitable = weak.lock();
+    if (!waitable || !state_->armed.erase(waitable->key())) continue;
+    ::epoll_ctl(state_->epoll_fd, EPOLL_CTL_DEL, waitable->wait_fd(), nullptr);
   }
+}
+
+void Executor::add_fd(int fd, std::function<void()> on_ready,
+                      std::shared_ptr<CallbackGroup> group) {
+  if (!group) group = std::make_shared<CallbackGroup>(CallbackGroupType::MutuallyExclusive);
+  auto waitable = std::make_shared<FdWaitable>(fd, std::move(on_ready), std::move(group));
+  std::lock_guard lock(state_->mutex);
+  if (state_->fds.contains(fd)) {
+    throw std::invalid_argument("agnocast: descriptor " + std::to_string(fd) +
+                                " is already added to this executor");
+  }
+  watch(state_->epoll_fd, fd, waitable->key(), state_->waitable_events, EPOLL_CTL_ADD);
+  state_->armed.emplace(waitable->key(), waitable);
+  state_->fds.emplace(fd, std::move(waitable));
+}
+
+void Executor::remove_fd(int fd) {
+  std::lock_guard lock(state_->mutex);
+  const auto found = state_->fds.find(fd);
+  if (found == state_->fds.end()) return;
+  ::epoll_ctl(state_->epoll_fd, EPOLL_CTL_DEL, fd, nullptr);
+  state_->armed.erase(found->second->key());
+  state_->fds.erase(found);
 }
 
 void Executor::begin_spin() { drain_eventfd(state_->cancel_fd); }

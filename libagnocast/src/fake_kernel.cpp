@@ -73,10 +73,12 @@ EndpointId FakeKernel::add_subscriber(const EndpointRequest& request) {
   subscriber.depth = request.depth;
   subscriber.transient_local = request.transient_local;
   subscriber.polling = request.polling;
+  subscriber.ignore_local = request.ignore_local;
   if (request.transient_local) {
     std::vector<std::uint64_t> kept;
     for (const auto& [publisher_id, publisher] : topic.publishers) {
       if (!publisher.transient_local) continue;
+      if (subscriber.ignore_local && publisher.pid == caller_pid_) continue;
       kept.insert(kept.end(), publisher.window.begin(), publisher.window.end());
     }
     std::sort(kept.begin(), kept.end());
@@ -150,6 +152,7 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
   PublishResult result;
   result.entry_id = entry_id;
   for (auto& [id, subscriber] : topic.subscribers) {
+    if (subscriber.ignore_local && subscriber.pid == caller_pid_) continue;
     subscriber.unreceived.push_back(entry_id);
     ++entries_[entry_id].unreceived_by;
     if (subscriber.unreceived.size() > subscriber.depth) {
@@ -261,6 +264,7 @@ TakeResult FakeKernel::take(EndpointId subscriber_id) {
 void FakeKernel::release(EndpointId subscriber_id, std::uint64_t entry_id) {
   std::lock_guard lock(mutex_);
   ++calls_.release;
+  if (release_error_) fail("RELEASE", release_error_);
   Subscriber& subscriber = subscriber_of(subscriber_id);
   const auto held = subscriber.held.find(entry_id);
   if (held == subscriber.held.end()) fail("RELEASE", ENOENT);
@@ -303,6 +307,11 @@ FakeKernel::Calls FakeKernel::calls() const {
 std::size_t FakeKernel::live_entries() const {
   std::lock_guard lock(mutex_);
   return entries_.size();
+}
+
+void FakeKernel::fail_releases(int err) {
+  std::lock_guard lock(mutex_);
+  release_error_ = err;
 }
 
 void FakeKernel::set_caller_pid(pid_t pid) {

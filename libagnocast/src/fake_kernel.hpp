@@ -53,6 +53,8 @@ class FakeKernel final : public Kernel {
   std::size_t live_entries() const;
   // The process the next calls come from, to act as several processes.
   void set_caller_pid(pid_t pid);
+  // From now on release() fails with err (0: succeeds again).
+  void fail_releases(int err);
 
  private:
   struct Entry {
@@ -78,6 +80,7 @@ class FakeKernel final : public Kernel {
     std::uint32_t depth = 1;
     bool transient_local = false;
     bool polling = false;
+    bool ignore_local = false;
     std::deque<std::uint64_t> unreceived;
     std::multiset<std::uint64_t> held;
     std::uint64_t received = 0;
@@ -108,6 +111,7 @@ class FakeKernel final : public Kernel {
   std::map<std::uint64_t, Entry> entries_;
   std::map<pid_t, std::deque<std::uint64_t>> reclaimable_;  // addresses per owning process
   Calls calls_;
+  int release_error_ = 0;
 };
 
 }  // namespace agnocast::detail

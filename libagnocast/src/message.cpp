@@ -3,6 +3,8 @@
 #include "agnocast/detail/message.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
 
 #include "agnocast/allocator.hpp"
 #include "runtime.hpp"
@@ -26,7 +28,7 @@ void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void
   void* block = Runtime::get().allocate(offset + size, align);
   void* message = static_cast<char*>(block) + offset;
   const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
-  *header_of(message) = MessageHeader{destroy, block, &thread_counter, thread_counter};
+  *header_of(message) = MessageHeader{destroy, block, &thread_counter, thread_counter, 0, 0};
   return message;
 }
 
@@ -35,6 +37,25 @@ std::uint64_t published_bytes(void* message, std::size_t size) noexcept {
   const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
   if (header.borrowing_thread_counter != &thread_counter) return size;
   return size + (thread_counter - header.pool_bytes_at_borrow);
+}
+
+void stamp_publication(void* message, std::uint64_t bytes) noexcept {
+  MessageHeader& header = *header_of(message);
+  header.publish_time = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::steady_clock::now().time_since_epoch())
+                            .count();
+  header.published_bytes = bytes;
+}
+
+Publication read_publication(const void* message, const void* pool_begin,
+                             std::size_t pool_size) noexcept {
+  const auto at = reinterpret_cast<std::uintptr_t>(message);
+  const auto begin = reinterpret_cast<std::uintptr_t>(pool_begin);
+  // Another process wrote the address: only trust a header inside its pool.
+  if (at < begin + header_room || at - begin > pool_size) return {};
+  const auto* header =
+      reinterpret_cast<const MessageHeader*>(static_cast<const char*>(message) - header_room);
+  return Publication{header->publish_time, header->published_bytes};
 }
 
 void free_message_memory(void* message) noexcept { pool_deallocate(header_of(message)->block); }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <stdexcept>
 
@@ -34,23 +35,41 @@ Node::~Node() = default;
 
 const std::string& Node::get_name() const { return state_->name; }
 
+std::shared_ptr<CallbackGroup> Node::create_callback_group(CallbackGroupType type) {
+  return std::make_shared<CallbackGroup>(type);
+}
+
+const std::shared_ptr<CallbackGroup>& Node::get_default_callback_group() const {
+  return state_->default_group;
+}
+
+std::shared_ptr<Timer> Node::create_timer(std::chrono::nanoseconds period,
+                                          std::function<void()> callback,
+                                          std::shared_ptr<CallbackGroup> group) {
+  auto timer = std::make_shared<Timer>(period, std::move(callback),
+                                       detail::group_or_default(*state_, std::move(group)));
+  detail::register_waitable(*state_, timer);
+  return timer;
+}
+
 namespace detail {
 
-void NodeState::add_subscription(const std::shared_ptr<SubscriptionBase>& subscription) {
+void NodeState::add_waitable(const std::shared_ptr<Waitable>& waitable) {
   std::lock_guard lock(mutex);
-  subscriptions[subscription->key()] = subscription;
+  std::erase_if(waitables, [](const auto& entry) { return entry.second.expired(); });
+  waitables[waitable->key()] = waitable;
   notify_watchers();
 }
 
-void NodeState::remove_subscription(std::uint64_t key) {
+void NodeState::remove_waitable(std::uint64_t key) {
   std::lock_guard lock(mutex);
-  subscriptions.erase(key);
+  waitables.erase(key);
 }
 
-std::vector<std::weak_ptr<SubscriptionBase>> NodeState::subscriptions_snapshot() {
+std::vector<std::weak_ptr<Waitable>> NodeState::waitables_snapshot() {
   std::lock_guard lock(mutex);
-  std::vector<std::weak_ptr<SubscriptionBase>> snapshot;
-  for (const auto& [key, subscription] : subscriptions) snapshot.push_back(subscription);
+  std::vector<std::weak_ptr<Waitable>> snapshot;
+  for (const auto& [key, waitable] : waitables) snapshot.push_back(waitable);
   return snapshot;
 }
 
@@ -71,9 +90,23 @@ void NodeState::notify_watchers() {
   }
 }
 
-void register_subscription(NodeState& node, const std::shared_ptr<SubscriptionBase>& subscription) {
-  node.add_subscription(subscription);
+std::shared_ptr<CallbackGroup> group_or_default(const NodeState& node,
+                                                std::shared_ptr<CallbackGroup> requested) {
+  return requested ? std::move(requested) : node.default_group;
 }
+
+void register_waitable(NodeState& node, const std::shared_ptr<Waitable>& waitable) {
+  node.add_waitable(waitable);
+}
+
+namespace {
+std::atomic<std::uint64_t> next_waitable_key{1};
+}  // namespace
+
+Waitable::Waitable(std::shared_ptr<CallbackGroup> group)
+    : key_(next_waitable_key.fetch_add(1)), group_(std::move(group)) {}
+
+Waitable::~Waitable() = default;
 
 }  // namespace detail
 }  // namespace agnocast

@@ -1,4 +1,5 @@
-// What executors need from a node: its subscriptions and a way to hear of new ones.
+// What executors need from a node: its subscriptions and timers, and a way to
+// hear of new ones.
 #pragma once
 
 #include <cstdint>
@@ -13,22 +14,25 @@
 namespace agnocast::detail {
 
 struct NodeState {
-  explicit NodeState(std::string node_name) : name(std::move(node_name)) {}
+  explicit NodeState(std::string node_name)
+      : name(std::move(node_name)),
+        default_group(std::make_shared<CallbackGroup>(CallbackGroupType::MutuallyExclusive)) {}
 
-  void add_subscription(const std::shared_ptr<SubscriptionBase>& subscription);
-  void remove_subscription(std::uint64_t key);
-  std::vector<std::weak_ptr<SubscriptionBase>> subscriptions_snapshot();
-  // An executor's eventfd, written whenever the subscriptions change.
+  void add_waitable(const std::shared_ptr<Waitable>& waitable);
+  void remove_waitable(std::uint64_t key);
+  std::vector<std::weak_ptr<Waitable>> waitables_snapshot();
+  // An executor's eventfd, written whenever the waitables change.
   void add_watcher(int eventfd);
   void remove_watcher(int eventfd);
 
   const std::string name;
+  const std::shared_ptr<CallbackGroup> default_group;
 
  private:
   void notify_watchers();  // with mutex held
 
   std::mutex mutex;
-  std::map<std::uint64_t, std::weak_ptr<SubscriptionBase>> subscriptions;
+  std::map<std::uint64_t, std::weak_ptr<Waitable>> waitables;
   std::vector<int> watchers;
 };
 

@@ -11,6 +11,7 @@
 
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
+#include "log_internal.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -116,7 +117,15 @@ void QueueSenders::notify(std::uint32_t subscriber_id) {
   if (found == descriptors_.end()) {
     const mqd_t descriptor =
         ::mq_open(queue_name(topic_, subscriber_id).c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
-    if (descriptor == -1) return;  // not created yet (ENOENT) or unusable: nothing to wake
+    if (descriptor == -1) {
+      // Not created yet (ENOENT): the subscriber wakes itself once it has made its queue.
+      if (errno != ENOENT) {
+        log(LogLevel::warning, "cannot open the notification queue " +
+                                   queue_name(topic_, subscriber_id) +
+                                   " to wake its subscriber: " + std::strerror(errno));
+      }
+      return;
+    }
     // Ids of gone subscribers are never reused, so the cache only grows; bound it.
     if (descriptors_.size() >= max_cached_senders) {
       for (const auto& [id, cached] : descriptors_) ::mq_close(cached);
@@ -125,9 +134,17 @@ void QueueSenders::notify(std::uint32_t subscriber_id) {
     found = descriptors_.emplace(subscriber_id, descriptor).first;
   }
   const MqMsgAgnocast message{};
-  while (::mq_send(found->second, reinterpret_cast<const char*>(&message), sizeof message, 0) !=
-             0 &&
-         errno == EINTR) {
+  for (;;) {
+    if (::mq_send(found->second, reinterpret_cast<const char*>(&message), sizeof message, 0) == 0) {
+      return;
+    }
+    if (errno == EINTR) continue;
+    // Full: a wake-up is already waiting, which is all a notification says.
+    if (errno != EAGAIN) {
+      log(LogLevel::warning,
+          "cannot notify " + queue_name(topic_, subscriber_id) + ": " + std::strerror(errno));
+    }
+    return;
   }
 }
 

@@ -1,13 +1,18 @@
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
+#include <chrono>
 #include <mutex>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
 #include "endpoint_request.hpp"
+#include "log_internal.hpp"
 #include "node_state.hpp"
 #include "notification_queue.hpp"
 #include "runtime.hpp"
@@ -48,13 +53,35 @@ PublisherCore::~PublisherCore() {
   try {
     state_->runtime.kernel().remove_publisher(state_->endpoint);
     state_->runtime.reclaim_all();
-  } catch (const Error&) {
-    // Destructors cannot report; the kernel drops everything at process exit.
+  } catch (const Error& error) {
+    // Destructors cannot throw; the kernel drops everything at process exit.
+    log(LogLevel::warning,
+        std::string("removing a publisher of ") + state_->topic + ": " + error.what());
   }
 }
 
 const std::string& PublisherCore::topic() const { return state_->topic; }
 std::uint32_t PublisherCore::id() const { return state_->endpoint.id; }
+
+std::size_t PublisherCore::subscription_count() const {
+  TopicInfo info;
+  if (!state_->runtime.kernel().topic_info(state_->topic, info)) return 0;
+  return info.subscribers.size();
+}
+
+bool PublisherCore::wait_for_subscribers(std::size_t count,
+                                         std::chrono::nanoseconds timeout) const {
+  // Nothing wakes a publisher when a subscriber joins: poll, often enough for
+  // start-up ordering and cheap next to a process start.
+  constexpr auto interval = std::chrono::milliseconds{5};
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    if (subscription_count() >= count) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) return false;
+    std::this_thread::sleep_for(std::min<std::chrono::nanoseconds>(interval, deadline - now));
+  }
+}
 
 void PublisherCore::publish(void* message, std::size_t bytes) {
   State& state = *state_;
@@ -65,6 +92,7 @@ void PublisherCore::publish(void* message, std::size_t bytes) {
   }
   std::array<std::uint64_t, 64> reclaimed;
   PublishResult result;
+  stamp_publication(message, bytes);
   {
     std::lock_guard lock(state.mutex);
     for (;;) {

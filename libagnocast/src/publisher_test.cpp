@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "agnocast/node.hpp"
@@ -60,6 +62,42 @@ TEST_F(PublisherTest, RefusesAMessageAlreadyPublished) {
   publisher->publish(std::move(message));
   EXPECT_THROW(publisher->publish(std::move(message)), std::invalid_argument);
   EXPECT_EQ(kernel().calls().publish, 1);
+}
+
+TEST_F(PublisherTest, CountsSubscribersOfEveryKind) {
+  Node node{"count"};
+  const std::string name = topic("count");
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  EXPECT_EQ(publisher->get_subscription_count(), 0U);
+  auto callback =
+      node.create_subscription<Counted>(name, QoS{1}, [](const ipc_shared_ptr<const Counted>&) {});
+  auto polling = node.create_polling_subscriber<Counted>(name, QoS{1});
+  EXPECT_EQ(publisher->get_subscription_count(), 2U);
+  EXPECT_EQ(callback->get_publisher_count(), 1U);
+  EXPECT_EQ(polling->get_publisher_count(), 1U);
+  polling.reset();
+  EXPECT_EQ(publisher->get_subscription_count(), 1U);
+}
+
+TEST_F(PublisherTest, WaitForSubscribersReturnsOnceEnoughJoinedOrAtTheTimeout) {
+  using namespace std::chrono_literals;
+  Node node{"wait"};
+  const std::string name = topic("wait");
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(publisher->wait_for_subscribers(1, 30ms));
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 30ms);
+
+  std::shared_ptr<PollingSubscriber<Counted>> late;
+  std::thread joiner([&] {
+    std::this_thread::sleep_for(50ms);
+    late = node.create_polling_subscriber<Counted>(name, QoS{1});
+  });
+  start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(publisher->wait_for_subscribers(1, 10s));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  joiner.join();
+  EXPECT_TRUE(publisher->wait_for_subscribers(1, 0s));
 }
 
 }  // namespace

@@ -155,7 +155,7 @@ void* Runtime::allocate(std::size_t size, std::size_t align) {
       std::lock_guard lock(pool_mutex_);
       if (void* ptr = pool_.allocate(size, align)) return ptr;
     }
-    if (attempt == 2) break;
+    if (attempt == 2 || !kernel_) break;
     if (attempt == 1) kernel_->shed();
     reclaim_all();
   }

@@ -23,9 +23,11 @@ class Runtime {
   static Runtime& get();
   // The runtime if this process has one already, else nullptr; never initializes.
   static Runtime* current() noexcept;
-  // A runtime over a caller-provided region and kernel (a FakeKernel), for native tests.
+  // A runtime over a caller-provided region, for native tests: with a kernel
+  // (a FakeKernel) publishers and subscriptions work, without one only
+  // allocation in the pool does.
   static Runtime& install_for_testing(void* region, std::size_t size,
-                                      std::unique_ptr<Kernel> kernel);
+                                      std::unique_ptr<Kernel> kernel = nullptr);
 
   Kernel& kernel() const { return *kernel_; }
   pid_t pid() const { return pid_; }
@@ -52,7 +54,7 @@ class Runtime {
   static Runtime* create();
   static void forget_in_fork_child() noexcept;
 
-  std::unique_ptr<Kernel> kernel_;
+  std::unique_ptr<Kernel> kernel_;  // absent only in native tests of allocation
   // False for a test runtime, whose region and kernel the test owns.
   bool pool_mapped_here_ = false;
   pid_t pid_;

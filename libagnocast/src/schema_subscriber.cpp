@@ -44,7 +44,7 @@ SchemaSubscriber::SchemaSubscriber(Node& node, std::string_view topic, const QoS
 }
 
 std::optional<SchemaMessage> SchemaSubscriber::take() {
-  const detail::TakenEntry taken = core_->take();
+  const detail::TakenEntry taken = core_->take_new();
   if (!taken.message) return std::nullopt;
   return SchemaMessage(taken.message, detail::Runtime::get().pool_holding(taken.message),
                        taken.reference);

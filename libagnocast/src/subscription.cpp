@@ -7,6 +7,7 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
 #include "endpoint_request.hpp"
+#include "log_internal.hpp"
 #include "node_state.hpp"
 #include "notification_queue.hpp"
 #include "runtime.hpp"
@@ -25,8 +26,9 @@ class SubscriberEndpoint : public EntryOwner {
     if (!still_ours()) return;
     try {
       runtime_.kernel().remove_subscriber(id_);
-    } catch (const Error&) {
-      // Destructors cannot report; the kernel drops everything at process exit.
+    } catch (const Error& error) {
+      // Destructors cannot throw; the kernel drops everything at process exit.
+      log(LogLevel::warning, std::string("removing a subscriber: ") + error.what());
     }
   }
 
@@ -34,8 +36,9 @@ class SubscriberEndpoint : public EntryOwner {
     if (!still_ours()) return;
     try {
       runtime_.kernel().release(id_, entry_id);
-    } catch (const Error&) {
-      // As above: nothing useful to do with it here.
+    } catch (const Error& error) {
+      // Called when the last pointer to a message goes: nobody to throw to.
+      log(LogLevel::warning, std::string("releasing a received message: ") + error.what());
     }
   }
 
@@ -57,8 +60,6 @@ class SubscriberEndpoint : public EntryOwner {
   const EndpointId id_;
 };
 
-std::atomic<std::uint64_t> next_subscription_key{1};
-
 // Maps every granted pool (closing each descriptor) and throws the first failure.
 void map_pools(Runtime& runtime, std::span<const PoolGrant> pools) {
   std::exception_ptr failure;
@@ -72,22 +73,38 @@ void map_pools(Runtime& runtime, std::span<const PoolGrant> pools) {
   if (failure) std::rethrow_exception(failure);
 }
 
+// What the callback may learn besides the message, from the kernel and the header.
+MessageInfo info_of(Runtime& runtime, const ReceivedEntry& entry) {
+  const auto* message = reinterpret_cast<const void*>(entry.addr);
+  const std::span<const std::byte> pool = runtime.pool_holding(message);
+  const Publication publication = read_publication(message, pool.data(), pool.size());
+  return MessageInfo{entry.publisher_id, entry.entry_id, publication.publish_time,
+                     publication.bytes};
+}
+
 }  // namespace
+
+std::size_t publisher_count(const std::string& topic) {
+  TopicInfo info;
+  if (!Runtime::get().kernel().topic_info(topic, info)) return 0;
+  return info.publishers.size();
+}
 
 struct SubscriptionBase::State {
   std::shared_ptr<NodeState> node;
   std::string topic;
   std::shared_ptr<SubscriberEndpoint> endpoint;
   std::unique_ptr<OwnedQueue> queue;
-  std::uint64_t key = 0;
   std::mutex receive_mutex;
 };
 
 SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic,
-                                   const QoS& qos, const MessageType& type)
-    : state_(std::make_unique<State>()) {
-  const EndpointRequest request =
+                                   const QoS& qos, const MessageType& type,
+                                   const SubscriptionOptions& options)
+    : Waitable(options.callback_group), state_(std::make_unique<State>()) {
+  EndpointRequest request =
       make_endpoint_request(node->name, topic, qos, EndpointKind::callback_subscriber, type);
+  request.ignore_local = options.ignore_local_publications;
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
@@ -96,11 +113,10 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
       agnocast::queue_name(topic, state_->endpoint->id().id), qos.depth());
   // Entries published before the queue existed woke nobody: wake ourselves.
   state_->queue->notify();
-  state_->key = next_subscription_key.fetch_add(1);
 }
 
 SubscriptionBase::~SubscriptionBase() {
-  state_->node->remove_subscription(state_->key);
+  state_->node->remove_waitable(key());
   state_->endpoint.reset();  // removes the kernel subscriber unless messages are still held
   state_->queue.reset();     // then unlinks the queue
 }
@@ -109,7 +125,6 @@ const std::string& SubscriptionBase::topic() const { return state_->topic; }
 std::uint32_t SubscriptionBase::id() const { return state_->endpoint->id().id; }
 const std::string& SubscriptionBase::queue_name() const { return state_->queue->name(); }
 int SubscriptionBase::queue_fd() const { return state_->queue->fd(); }
-std::uint64_t SubscriptionBase::key() const { return state_->key; }
 
 std::size_t SubscriptionBase::handle_wakeup() {
   State& state = *state_;
@@ -135,7 +150,8 @@ std::size_t SubscriptionBase::handle_wakeup() {
       map_pools(runtime, std::span(pools.data(), result.pool_count));
       while (handed_out < result.entry_count) {
         const std::size_t i = handed_out++;
-        deliver(reinterpret_cast<const void*>(entries[i].addr), references[i]);
+        deliver(reinterpret_cast<const void*>(entries[i].addr), references[i],
+                info_of(runtime, entries[i]));
         ++delivered;
       }
     } catch (...) {
@@ -155,24 +171,32 @@ struct PollingCore::State {
   std::shared_ptr<NodeState> node;
   std::string topic;
   std::shared_ptr<SubscriberEndpoint> endpoint;
+  std::mutex take_mutex;
+  // The message taken last, held for take_latest() to give again.
+  TakenEntry latest;
 };
 
 PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
-                         const MessageType& type)
+                         const MessageType& type, const SubscriptionOptions& options)
     : state_(std::make_unique<State>()) {
-  const EndpointRequest request =
+  EndpointRequest request =
       make_endpoint_request(node->name, topic, qos, EndpointKind::polling_subscriber, type);
+  request.ignore_local = options.ignore_local_publications;
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
 }
 
-PollingCore::~PollingCore() = default;
+PollingCore::~PollingCore() {
+  if (state_->latest.reference) release(state_->latest.reference);
+}
 
 const std::string& PollingCore::topic() const { return state_->topic; }
 std::uint32_t PollingCore::id() const { return state_->endpoint->id().id; }
 
-TakenEntry PollingCore::take() {
+// With take_mutex held: asks the kernel for the newest unreceived entry and
+// makes it the latest. Returns false when there is none.
+bool PollingCore::take_newer() {
   SubscriberEndpoint& endpoint = *state_->endpoint;
   const TakeResult taken = endpoint.runtime().kernel().take(endpoint.id());
   EntryReference* reference =
@@ -185,8 +209,25 @@ TakenEntry PollingCore::take() {
       throw;
     }
   }
-  if (!reference) return {};
-  return TakenEntry{reinterpret_cast<const void*>(taken.entry.addr), reference};
+  if (!reference) return false;
+  if (state_->latest.reference) release(state_->latest.reference);
+  state_->latest = TakenEntry{reinterpret_cast<const void*>(taken.entry.addr), reference};
+  return true;
+}
+
+TakenEntry PollingCore::take_new() {
+  std::lock_guard lock(state_->take_mutex);
+  if (!take_newer()) return {};
+  retain(state_->latest.reference);
+  return state_->latest;
+}
+
+TakenEntry PollingCore::take_latest() {
+  std::lock_guard lock(state_->take_mutex);
+  take_newer();
+  if (!state_->latest.reference) return {};
+  retain(state_->latest.reference);
+  return state_->latest;
 }
 
 }  // namespace agnocast::detail

@@ -1,7 +1,9 @@
 #include "agnocast/subscription.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -113,6 +115,92 @@ TEST_F(SubscriptionTest, ASubscriptionOutlivedByItsMessagesKeepsThemValid) {
   kept.reset();
   ASSERT_TRUE(kernel().topic_info(name, info));
   EXPECT_TRUE(info.subscribers.empty());
+}
+
+TEST_F(SubscriptionTest, CallbacksMayTakeTheMessageAndItsInfo) {
+  Node node{"forms"};
+  const std::string name = topic("forms");
+  std::vector<std::uint64_t> by_reference;
+  std::vector<MessageInfo> infos;
+  auto plain = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const Counted& m) { by_reference.push_back(m.seq); });
+  auto with_info = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const Counted& m, const MessageInfo& info) {
+        EXPECT_EQ(m.seq, 5U);
+        infos.push_back(info);
+      });
+  auto pointer_with_info = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>& m, const MessageInfo& info) {
+        EXPECT_EQ(m->seq, 5U);
+        infos.push_back(info);
+      });
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  const auto before = std::chrono::steady_clock::now().time_since_epoch();
+  publish(*publisher, 5);
+  const auto after = std::chrono::steady_clock::now().time_since_epoch();
+  plain->handle_wakeup();
+  with_info->handle_wakeup();
+  pointer_with_info->handle_wakeup();
+
+  EXPECT_EQ(by_reference, std::vector<std::uint64_t>{5});
+  ASSERT_EQ(infos.size(), 2U);
+  for (const MessageInfo& info : infos) {
+    EXPECT_EQ(info.publisher_id, publisher->id());
+    EXPECT_EQ(info.bytes, sizeof(Counted));
+    EXPECT_GE(info.publish_time, std::chrono::nanoseconds(before).count());
+    EXPECT_LE(info.publish_time, std::chrono::nanoseconds(after).count());
+  }
+  EXPECT_EQ(infos[0].entry_id, infos[1].entry_id);
+}
+
+TEST_F(SubscriptionTest, IgnoringLocalPublicationsGetsOnlyOtherProcesses) {
+  Node node{"local"};
+  const std::string name = topic("local");
+  std::vector<std::uint64_t> seen;
+  SubscriptionOptions options;
+  options.ignore_local_publications = true;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{2}, [&](const Counted& m) { seen.push_back(m.seq); }, options);
+  auto own = node.create_publisher<Counted>(name, QoS{10});
+  kernel().set_caller_pid(::getpid() + 100000);  // another process
+  auto other = node.create_publisher<Counted>(name, QoS{10});
+  publish(*other, 100);
+  kernel().set_caller_pid(::getpid());
+  for (std::uint64_t seq = 0; seq < 5; ++seq) publish(*own, seq);
+
+  subscription->handle_wakeup();
+  // Five own messages did not push the other process's out of a depth of 2.
+  EXPECT_EQ(seen, std::vector<std::uint64_t>{100});
+}
+
+TEST_F(SubscriptionTest, TakeDataGivesTheNewestAgainUntilSomethingNewerArrives) {
+  Node node{"take"};
+  const std::string name = topic("take");
+  auto poll = node.create_polling_subscriber<Counted>(name, QoS{3});
+  auto publisher = node.create_publisher<Counted>(name, QoS{3});
+  EXPECT_FALSE(poll->take_data()) << "empty before the first message";
+  EXPECT_FALSE(poll->take_new_data());
+
+  for (std::uint64_t seq = 1; seq <= 3; ++seq) publish(*publisher, seq);
+  auto first = poll->take_data();
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->seq, 3U) << "the newest within depth";
+  auto again = poll->take_data();
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again.get(), first.get()) << "the same message again";
+  EXPECT_FALSE(poll->take_new_data()) << "nothing new since";
+
+  publish(*publisher, 4);
+  auto fresh = poll->take_new_data();
+  ASSERT_TRUE(fresh);
+  EXPECT_EQ(fresh->seq, 4U);
+  EXPECT_EQ(poll->take_data()->seq, 4U);
+  // Only the latest stays held for take_data(); 1..3 went back to the publisher.
+  first.reset();
+  again.reset();
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 1U);
 }
 
 }  // namespace

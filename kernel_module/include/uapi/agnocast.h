@@ -53,6 +53,12 @@
 #define AGNOCAST_TRANSIENT_LOCAL (1U << 0)
 /* Subscriber only: woken by nobody, reads with TAKE instead of RECEIVE. */
 #define AGNOCAST_POLLING (1U << 1)
+/*
+ * Subscriber only: entries published by the subscriber's own process are
+ * never queued for it (nor woken for, nor given as transient-local history),
+ * so they never take its depth.
+ */
+#define AGNOCAST_IGNORE_LOCAL (1U << 2)
 
 /*
  * AGNOCAST_IOC_GET_VERSION: never fails but for -EFAULT.
@@ -122,8 +128,8 @@ struct agnocast_register_process {
  * first unreceived entries, up to depth of the newest entries still in the
  * window of publishers that are transient-local too.
  *
- *   -EINVAL  bad name, label, type name, depth, flags (POLLING on a
- *            publisher), schema_size or reserved
+ *   -EINVAL  bad name, label, type name, depth, flags (POLLING or
+ *            IGNORE_LOCAL on a publisher), schema_size or reserved
  *   -EPROTOTYPE the topic's type has another name or hash (TOPIC_INFO tells
  *            which)
  *   -ENOSPC  the topic has PUBLISHERS/SUBSCRIBERS_PER_TOPIC_MAX endpoints

@@ -1,19 +1,24 @@
 #pragma once
 
+#include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
 
+#include "agnocast/callback_group.hpp"
 #include "agnocast/message_traits.hpp"
 #include "agnocast/publisher.hpp"
 #include "agnocast/qos.hpp"
 #include "agnocast/subscription.hpp"
+#include "agnocast/subscription_options.hpp"
+#include "agnocast/timer.hpp"
 
 namespace agnocast {
 
-// A named group of publishers and subscriptions; the name is the label the
-// kernel module and agnocast-cli show. Executors spin nodes.
+// A named group of publishers, subscriptions and timers; the name is the label
+// the kernel module and agnocast-cli show. Executors spin nodes.
 class Node {
  public:
   // name: printable ASCII, at most 127 characters (std::invalid_argument otherwise).
@@ -30,26 +35,50 @@ class Node {
     return std::make_shared<Publisher<T>>(state_, topic, qos);
   }
 
+  // callback takes `const ipc_shared_ptr<const T>&` or `const T&`, either
+  // optionally followed by `const MessageInfo&`.
   template <class T, class Callback>
   std::shared_ptr<Subscription<T>> create_subscription(std::string_view topic, const QoS& qos,
-                                                       Callback&& callback) {
+                                                       Callback&& callback,
+                                                       SubscriptionOptions options = {}) {
     static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
-    auto subscription = std::make_shared<Subscription<T>>(
-        state_, topic, qos, typename Subscription<T>::Callback(std::forward<Callback>(callback)));
-    detail::register_subscription(*state_, subscription);
+    auto adapted = detail::adapt_callback<T>(std::forward<Callback>(callback));
+    options.callback_group = detail::group_or_default(*state_, std::move(options.callback_group));
+    auto subscription =
+        std::make_shared<Subscription<T>>(state_, topic, qos, std::move(adapted), options);
+    detail::register_waitable(*state_, subscription);
     return subscription;
   }
 
+  // options.callback_group does not apply: a polling subscriber has no callback.
   template <class T>
-  std::shared_ptr<PollingSubscriber<T>> create_polling_subscriber(std::string_view topic,
-                                                                  const QoS& qos) {
+  std::shared_ptr<PollingSubscriber<T>> create_polling_subscriber(
+      std::string_view topic, const QoS& qos, const SubscriptionOptions& options = {}) {
     static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
-    return std::make_shared<PollingSubscriber<T>>(state_, topic, qos);
+    return std::make_shared<PollingSubscriber<T>>(state_, topic, qos, options);
   }
+
+  // Calls callback every period (steady clock) from the executor spinning
+  // this node; group empty: the node's default group.
+  template <class Rep, class Period>
+  std::shared_ptr<Timer> create_wall_timer(std::chrono::duration<Rep, Period> period,
+                                           std::function<void()> callback,
+                                           std::shared_ptr<CallbackGroup> group = nullptr) {
+    return create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(period),
+                        std::move(callback), std::move(group));
+  }
+
+  std::shared_ptr<CallbackGroup> create_callback_group(CallbackGroupType type);
+  // MutuallyExclusive: without groups of their own, a node's callbacks never overlap.
+  const std::shared_ptr<CallbackGroup>& get_default_callback_group() const;
 
   const std::shared_ptr<detail::NodeState>& state() const { return state_; }
 
  private:
+  std::shared_ptr<Timer> create_timer(std::chrono::nanoseconds period,
+                                      std::function<void()> callback,
+                                      std::shared_ptr<CallbackGroup> group);
+
   std::shared_ptr<detail::NodeState> state_;
 };
 

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <memory>
 #include <new>
 #include <stdexcept>
@@ -48,6 +50,16 @@ class Publisher {
 
   const std::string& get_topic_name() const { return core_.topic(); }
   std::uint32_t id() const { return core_.id(); }
+
+  // Live subscribers of the topic, in every process (polling ones included).
+  std::size_t get_subscription_count() const { return core_.subscription_count(); }
+  // Waits until the topic has at least count subscribers: true then, false
+  // once timeout has passed without.
+  template <class Rep, class Period>
+  bool wait_for_subscribers(std::size_t count, std::chrono::duration<Rep, Period> timeout) const {
+    return core_.wait_for_subscribers(
+        count, std::chrono::duration_cast<std::chrono::nanoseconds>(timeout));
+  }
 
  private:
   detail::PublisherCore core_;

@@ -2,6 +2,7 @@
 // PollingSubscriber<T>; the templates only add the message type.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -10,9 +11,12 @@
 #include <string_view>
 
 #include "agnocast/detail/message.hpp"
+#include "agnocast/detail/waitable.hpp"
+#include "agnocast/message_info.hpp"
 #include "agnocast/message_traits.hpp"
 #include "agnocast/qos.hpp"
 #include "agnocast/schema.hpp"
+#include "agnocast/subscription_options.hpp"
 
 namespace agnocast::detail {
 
@@ -43,6 +47,10 @@ class PublisherCore {
   void publish(void* message, std::size_t bytes);
   const std::string& topic() const;
   std::uint32_t id() const;
+  // Live subscribers of the topic, in every process.
+  std::size_t subscription_count() const;
+  // True as soon as the topic has at least count subscribers; false after timeout.
+  bool wait_for_subscribers(std::size_t count, std::chrono::nanoseconds timeout) const;
 
  private:
   struct State;
@@ -55,52 +63,63 @@ struct TakenEntry {
   EntryReference* reference = nullptr;
 };
 
+// Live publishers of a topic, in every process.
+std::size_t publisher_count(const std::string& topic);
+
 class PollingCore {
  public:
   PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
-              const MessageType& type);
+              const MessageType& type, const SubscriptionOptions& options = {});
   ~PollingCore();
   PollingCore(const PollingCore&) = delete;
   PollingCore& operator=(const PollingCore&) = delete;
 
   // The newest message not taken yet, or an empty TakenEntry.
-  TakenEntry take();
+  TakenEntry take_new();
+  // The newest message not taken yet, else the one taken last (again); empty
+  // only before the first message.
+  TakenEntry take_latest();
   const std::string& topic() const;
   std::uint32_t id() const;
 
  private:
+  bool take_newer();
+
   struct State;
   std::unique_ptr<State> state_;
 };
 
-class SubscriptionBase {
+class SubscriptionBase : public Waitable {
  public:
-  virtual ~SubscriptionBase();
-  SubscriptionBase(const SubscriptionBase&) = delete;
-  SubscriptionBase& operator=(const SubscriptionBase&) = delete;
+  ~SubscriptionBase() override;
 
   const std::string& topic() const;
   std::uint32_t id() const;
   // The notification queue this subscription owns, e.g. "/chatter@1".
   const std::string& queue_name() const;
   int queue_fd() const;
-  std::uint64_t key() const;  // unique in the process, for executors
   // Drains the queue, receives every waiting message and runs the callback
   // on each, oldest first; returns how many ran.
   std::size_t handle_wakeup();
 
+  int wait_fd() const override { return queue_fd(); }
+  void execute() override { handle_wakeup(); }
+
  protected:
   SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
-                   const MessageType& type);
+                   const MessageType& type, const SubscriptionOptions& options);
   // Must take ownership of reference (count one) even when it throws.
-  virtual void deliver(const void* message, EntryReference* reference) = 0;
+  virtual void deliver(const void* message, EntryReference* reference, const MessageInfo& info) = 0;
 
  private:
   struct State;
   std::unique_ptr<State> state_;
 };
 
-// Makes a new subscription visible to the executors that spin its node.
-void register_subscription(NodeState& node, const std::shared_ptr<SubscriptionBase>& subscription);
+// The group a new callback of the node joins: the requested one, else the node's default.
+std::shared_ptr<CallbackGroup> group_or_default(const NodeState& node,
+                                                std::shared_ptr<CallbackGroup> requested);
+// Makes a new subscription or timer visible to the executors that spin its node.
+void register_waitable(NodeState& node, const std::shared_ptr<Waitable>& waitable);
 
 }  // namespace agnocast::detail

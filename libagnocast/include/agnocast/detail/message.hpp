@@ -19,6 +19,9 @@ struct MessageHeader {
   // pool bytes that thread had allocated by then.
   const std::uint64_t* borrowing_thread_counter;
   std::uint64_t pool_bytes_at_borrow;
+  // Written at publish, read by subscribers for MessageInfo.
+  std::int64_t publish_time;  // steady clock nanoseconds
+  std::uint64_t published_bytes;
 };
 
 template <class T>
@@ -32,6 +35,16 @@ void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void
 // what the publishing thread allocated from the pool since borrowing it (the
 // vectors and strings filled in).  Just `size` when another thread borrowed it.
 std::uint64_t published_bytes(void* message, std::size_t size) noexcept;
+// Records publish time and size in the header, just before the message is published.
+void stamp_publication(void* message, std::uint64_t bytes) noexcept;
+// What a subscriber learns from the header of a received message; pool is the
+// mapped pool holding it (publish_time and bytes stay 0 when the header lies outside).
+struct Publication {
+  std::int64_t publish_time = 0;
+  std::uint64_t bytes = 0;
+};
+Publication read_publication(const void* message, const void* pool_begin,
+                             std::size_t pool_size) noexcept;
 // Frees memory from allocate_message whose object was never constructed.
 void free_message_memory(void* message) noexcept;
 // Destroys a constructed, unpublished message and frees its memory.

@@ -1,0 +1,33 @@
+// What an executor waits on: a descriptor that becomes readable, and the
+// callbacks to run then. Subscriptions, timers and added descriptors are waitables.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "agnocast/callback_group.hpp"
+
+namespace agnocast::detail {
+
+class Waitable {
+ public:
+  virtual ~Waitable();
+  Waitable(const Waitable&) = delete;
+  Waitable& operator=(const Waitable&) = delete;
+
+  virtual int wait_fd() const = 0;
+  // Handles the descriptor's readiness; called by one thread at a time.
+  virtual void execute() = 0;
+
+  std::uint64_t key() const { return key_; }  // unique in the process, for executors
+  const std::shared_ptr<CallbackGroup>& group() const { return group_; }
+
+ protected:
+  explicit Waitable(std::shared_ptr<CallbackGroup> group);
+
+ private:
+  const std::uint64_t key_;
+  const std::shared_ptr<CallbackGroup> group_;
+};
+
+}  // namespace agnocast::detail

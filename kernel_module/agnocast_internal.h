@@ -18,10 +18,13 @@
 #include <linux/idr.h>
 #include <linux/list.h>
 #include <linux/mutex.h>
+#include <linux/pid.h>
+#include <linux/slab.h>
 #include <linux/types.h>
 #include <linux/uidgid.h>
 #include <linux/wait.h>
 #include <linux/workqueue.h>
+#include <linux/xarray.h>
 
 #include "agnocast.h"
 
@@ -31,10 +34,10 @@
 #define AGNOCAST_SPARES_MAX 16
 
 struct ipc_namespace;
+struct file;
 struct pid;
 struct super_block;
 struct vfsmount;
-struct agnocast_exit_record_node;
 struct agnocast_policy_state;
 
 extern unsigned long agnocast_pool_size;
@@ -108,8 +111,8 @@ struct agnocast_proc {
 	/* Protected by ns->lock. */
 	struct list_head ns_node;
 	struct agnocast_mempool *pool;
-	struct list_head publishers;
-	struct list_head subscribers;
+	struct list_head publishers;	/* of agnocast_endpoint.proc_node */
+	struct list_head subscribers;	/* ditto */
 	unsigned int nr_publishers;
 	unsigned int nr_subscribers;
 	unsigned long *given;		/* pool_count bits: live pools handed over */
@@ -117,9 +120,9 @@ struct agnocast_proc {
 	struct list_head reclaim;	/* freed entries of this process's pool */
 	unsigned int nr_reclaim;
 	/* Freed bookkeeping kept for reuse, so publish and receive rarely allocate. */
-	struct list_head spare_msgs;
+	struct list_head spare_entries;
 	struct list_head spare_held;
-	unsigned int nr_spare_msgs;
+	unsigned int nr_spare_entries;
 	unsigned int nr_spare_held;
 };
 
@@ -137,6 +140,7 @@ struct agnocast_topic {
 	struct agnocast_ns *ns;
 	struct agnocast_id_space *ids;
 	u32 handle;
+	struct xarray endpoints;	/* id -> struct agnocast_endpoint */
 	struct list_head publishers;	/* by id */
 	struct list_head subscribers;	/* by id */
 	unsigned int nr_publishers;
@@ -153,43 +157,43 @@ struct agnocast_topic {
 	char name[AGNOCAST_TOPIC_NAME_MAX];
 };
 
-struct agnocast_publisher {
-	struct list_head topic_node;
-	struct list_head proc_node;
+/* What publishers and subscribers share: found by id in topic->endpoints. */
+struct agnocast_endpoint {
+	struct list_head topic_node;	/* on topic->publishers or ->subscribers */
+	struct list_head proc_node;	/* on proc->publishers or ->subscribers */
 	struct agnocast_topic *topic;
 	struct agnocast_proc *proc;
+	bool publisher;
 	u32 id;
 	u32 depth;
 	u32 flags;
+	char node[AGNOCAST_NODE_NAME_MAX];
+};
+
+struct agnocast_publisher {
+	struct agnocast_endpoint ep;
 	struct list_head window;	/* oldest first */
 	u32 window_len;
 	u64 published;
 	u64 published_bytes;
-	char node[AGNOCAST_NODE_NAME_MAX];
 };
 
 struct agnocast_subscriber {
-	struct list_head topic_node;
-	struct list_head proc_node;
-	struct agnocast_topic *topic;
-	struct agnocast_proc *proc;
-	u32 id;
-	u32 depth;
-	u32 flags;
-	/* Ring of depth unreceived entries, oldest at @head. */
-	struct agnocast_msg **unreceived;
+	struct agnocast_endpoint ep;
+	/* Ring of ep.depth unreceived entries, oldest at @head. */
+	struct agnocast_topic_entry **unreceived;
 	u32 head;
 	u32 nr_unreceived;
-	struct list_head held;		/* of struct agnocast_held */
+	struct list_head held;		/* of struct agnocast_held, receive order */
 	u32 nr_held;
 	u64 received;
 	u64 dropped;
 	/* Callback subscribers: queued when the process dies, NULL after. */
 	struct agnocast_exit_record_node *exit_record;
-	char node[AGNOCAST_NODE_NAME_MAX];
 };
 
-struct agnocast_msg {
+/* One published message of a topic; the UAPI's entry. */
+struct agnocast_topic_entry {
 	/* On topic->entries while live, on the owner's reclaim list after. */
 	struct list_head node;
 	struct list_head window_node;	/* valid while @publisher is set */
@@ -205,8 +209,31 @@ struct agnocast_msg {
 
 struct agnocast_held {
 	struct list_head node;
-	struct agnocast_msg *entry;
+	struct agnocast_topic_entry *entry;
 };
+
+/* Exit records: allocated with what they describe, queued at death. */
+struct agnocast_exit_record_node {
+	struct list_head node;
+	u32 kind;
+	u32 subscriber_id;
+	u64 seq;			/* order of queueing, from 1 */
+	struct pid *pid;
+	char topic[AGNOCAST_TOPIC_NAME_MAX];
+};
+
+static inline struct agnocast_exit_record_node *agnocast_exit_record_alloc(void)
+{
+	return kzalloc(sizeof(struct agnocast_exit_record_node), GFP_KERNEL_ACCOUNT);
+}
+
+static inline void agnocast_exit_record_free(struct agnocast_exit_record_node *rec)
+{
+	if (!rec)
+		return;
+	put_pid(rec->pid);
+	kfree(rec);
+}
 
 /* The calling process's view, valid between agnocast_enter/agnocast_leave. */
 struct agnocast_ctx {
@@ -223,6 +250,12 @@ void agnocast_ns_get(struct agnocast_ns *ns);
 void agnocast_ns_put(struct agnocast_ns *ns);
 void agnocast_ns_init(void);
 void agnocast_ns_exit(void);
+void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
+				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic);
+void agnocast_exit_records_wake(struct agnocast_ns *ns);
+bool agnocast_exit_records_waiting(const struct agnocast_ns *ns);
+ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
+				   size_t count, bool nonblock);
 
 /* agnocast_process.c */
 int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered);
@@ -231,17 +264,6 @@ int agnocast_process_init(void);
 void agnocast_process_exit(void);
 int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_unregister_process(struct agnocast_ns *file_ns);
-
-/* agnocast_exit_records.c */
-struct agnocast_exit_record_node *agnocast_exit_record_alloc(void);
-void agnocast_exit_record_free(struct agnocast_exit_record_node *rec);
-void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
-				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic);
-void agnocast_exit_records_wake(struct agnocast_ns *ns);
-bool agnocast_exit_records_waiting(const struct agnocast_ns *ns);
-void agnocast_exit_records_free(struct agnocast_ns *ns);
-ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
-				   size_t count, bool nonblock);
 
 /* agnocast_policy.c */
 int agnocast_policy_check(const struct agnocast_ns *ns, const char *topic, bool publisher);
@@ -256,15 +278,64 @@ int agnocast_pool_attach(struct agnocast_mempool *pool, int fd);
 void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool);
 bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
 				const struct agnocast_mempool *pool);
-int agnocast_pool_prepare(struct agnocast_mempool *pool, struct agnocast_pool *out);
-void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool *pool,
-			     int fd);
+void agnocast_pool_describe(struct agnocast_mempool *pool, struct agnocast_pool *out);
+void agnocast_pool_mark_given(struct agnocast_proc *proc, const struct agnocast_pool *granted,
+			      struct file *file);
 void agnocast_pool_drop_given(struct agnocast_proc *proc);
 
-/* agnocast_topic.c */
-void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
+/* agnocast_entry.c: the entry engine; no user copies, namespace lock held. */
+struct agnocast_topic_entry *agnocast_entry_alloc(struct agnocast_proc *proc);
+void agnocast_entry_free(struct agnocast_proc *proc, struct agnocast_topic_entry *entry);
+void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
+			    struct agnocast_mempool *pool, u64 addr, u64 bytes);
+void agnocast_publisher_drop_window(struct agnocast_publisher *pub);
+struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subscriber *sub,
+						     u32 i);
+void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
+void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
+int agnocast_held_alloc_list(struct agnocast_proc *proc, struct list_head *list, u32 n);
+void agnocast_held_free_list(struct agnocast_proc *proc, struct list_head *list);
+void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub, struct list_head *spare);
+void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct list_head *spare);
+struct agnocast_held *agnocast_sub_find_held(struct agnocast_subscriber *sub, u64 entry_id);
+void agnocast_sub_release(struct agnocast_subscriber *sub, struct agnocast_held *held);
+u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool);
+u32 agnocast_reclaim_peek(struct agnocast_proc *proc, u64 *addrs, u32 max);
+void agnocast_reclaim_forget(struct agnocast_proc *proc, u32 n);
+void agnocast_reclaim_return(struct agnocast_proc *proc, const u64 *addrs, u32 n);
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
+
+/* agnocast_topic.c: topics, id spaces, endpoints. */
+bool agnocast_topic_name_valid(const char *name);
+bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg, bool publisher);
+struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
+struct agnocast_topic *agnocast_topic_get(struct agnocast_ns *ns, const char *name);
+void agnocast_topic_maybe_free(struct agnocast_topic *topic);
+int agnocast_topic_type_check(struct agnocast_topic *topic,
+			      const struct agnocast_add_endpoint *arg, void **schema);
+struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
+						   struct agnocast_proc *proc,
+						   const struct agnocast_add_endpoint *arg,
+						   bool publisher);
+void agnocast_endpoint_commit(struct agnocast_endpoint *ep);
+void agnocast_endpoint_abandon(struct agnocast_endpoint *ep);
+void agnocast_endpoint_destroy(struct agnocast_endpoint *ep);
+int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool publisher,
+			     struct agnocast_endpoint **out);
+void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
 void agnocast_id_spaces_free(struct agnocast_ns *ns);
+
+static inline struct agnocast_publisher *agnocast_to_publisher(struct agnocast_endpoint *ep)
+{
+	return container_of(ep, struct agnocast_publisher, ep);
+}
+
+static inline struct agnocast_subscriber *agnocast_to_subscriber(struct agnocast_endpoint *ep)
+{
+	return container_of(ep, struct agnocast_subscriber, ep);
+}
+
+/* agnocast_ioctl.c: endpoint and data-path commands (copy in, call down, copy out). */
 int agnocast_add_publisher(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg);
@@ -275,8 +346,6 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg);
-bool agnocast_topic_name_valid(const char *name);
-struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
 
 /* agnocast_introspect.c */
 int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg);

@@ -90,31 +90,31 @@ static void agnocast_publisher_info_fill(struct agnocast_publisher_info *out,
 					 const struct agnocast_publisher *pub,
 					 struct pid_namespace *pid_ns)
 {
-	memcpy(out->node, pub->node, sizeof(out->node));
-	out->id = pub->id;
-	out->pid = pid_nr_ns(pub->proc->pid, pid_ns);
-	out->depth = pub->depth;
-	out->flags = pub->flags;
+	memcpy(out->node, pub->ep.node, sizeof(out->node));
+	out->id = pub->ep.id;
+	out->pid = pid_nr_ns(pub->ep.proc->pid, pid_ns);
+	out->depth = pub->ep.depth;
+	out->flags = pub->ep.flags;
 	out->published = pub->published;
 	out->published_bytes = pub->published_bytes;
 	out->window = pub->window_len;
-	out->uid = from_kuid_munged(current_user_ns(), pub->proc->uid);
+	out->uid = from_kuid_munged(current_user_ns(), pub->ep.proc->uid);
 }
 
 static void agnocast_subscriber_info_fill(struct agnocast_subscriber_info *out,
 					  const struct agnocast_subscriber *sub,
 					  struct pid_namespace *pid_ns)
 {
-	memcpy(out->node, sub->node, sizeof(out->node));
-	out->id = sub->id;
-	out->pid = pid_nr_ns(sub->proc->pid, pid_ns);
-	out->depth = sub->depth;
-	out->flags = sub->flags;
+	memcpy(out->node, sub->ep.node, sizeof(out->node));
+	out->id = sub->ep.id;
+	out->pid = pid_nr_ns(sub->ep.proc->pid, pid_ns);
+	out->depth = sub->ep.depth;
+	out->flags = sub->ep.flags;
 	out->unreceived = sub->nr_unreceived;
 	out->held = sub->nr_held;
 	out->received = sub->received;
 	out->dropped = sub->dropped;
-	out->uid = from_kuid_munged(current_user_ns(), sub->proc->uid);
+	out->uid = from_kuid_munged(current_user_ns(), sub->ep.proc->uid);
 }
 
 /* Answers of TOPIC_INFO, built under the namespace lock. */
@@ -129,8 +129,7 @@ static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_top
 				     struct agnocast_topic_answer *answer)
 {
 	struct pid_namespace *pid_ns = task_active_pid_ns(current);
-	struct agnocast_subscriber *sub;
-	struct agnocast_publisher *pub;
+	struct agnocast_endpoint *ep;
 	struct agnocast_topic *topic;
 	u32 i;
 
@@ -145,16 +144,17 @@ static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_top
 	if ((answer->npub && !answer->pubs) || (answer->nsub && !answer->subs))
 		return -ENOMEM;
 	i = 0;
-	list_for_each_entry(pub, &topic->publishers, topic_node) {
+	list_for_each_entry(ep, &topic->publishers, topic_node) {
 		if (i == answer->npub)
 			break;
-		agnocast_publisher_info_fill(&answer->pubs[i++], pub, pid_ns);
+		agnocast_publisher_info_fill(&answer->pubs[i++], agnocast_to_publisher(ep), pid_ns);
 	}
 	i = 0;
-	list_for_each_entry(sub, &topic->subscribers, topic_node) {
+	list_for_each_entry(ep, &topic->subscribers, topic_node) {
 		if (i == answer->nsub)
 			break;
-		agnocast_subscriber_info_fill(&answer->subs[i++], sub, pid_ns);
+		agnocast_subscriber_info_fill(&answer->subs[i++], agnocast_to_subscriber(ep),
+					      pid_ns);
 	}
 	arg->publisher_total = topic->nr_publishers;
 	arg->subscriber_total = topic->nr_subscribers;

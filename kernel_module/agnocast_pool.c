@@ -129,35 +129,29 @@ bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
 	return pool->owner != proc && !test_bit(pool->slot, proc->given);
 }
 
-/*
- * Handing a pool over is two-phase so that a call can fail without leaving a
- * descriptor behind: agnocast_pool_prepare() reserves a descriptor number
- * and describes the pool in @out; then either agnocast_pool_hand_over()
- * installs the read-only file there, or put_unused_fd() gives the number back.
- */
-int agnocast_pool_prepare(struct agnocast_mempool *pool, struct agnocast_pool *out)
+/* Describes @pool for a subscriber; the descriptor comes later. */
+void agnocast_pool_describe(struct agnocast_mempool *pool, struct agnocast_pool *out)
 {
-	int fd;
-
-	if (WARN_ON_ONCE(!pool->file))
-		return -EINVAL;
-	fd = get_unused_fd_flags(O_CLOEXEC);
-	if (fd < 0)
-		return fd;
 	memset(out, 0, sizeof(*out));
 	out->addr = pool->addr;
 	out->size = pool->size;
-	out->fd = fd;
+	out->fd = -1;
 	out->pid = pid_nr_ns(pool->owner_pid, task_active_pid_ns(current));
-	return 0;
 }
 
-void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool *pool,
-			     int fd)
+/*
+ * @proc now has a descriptor of @file, described by @granted: the pool is
+ * given if it is still the slot's pool (the file reference the caller holds
+ * keeps the file, and so the comparison, unambiguous).
+ */
+void agnocast_pool_mark_given(struct agnocast_proc *proc, const struct agnocast_pool *granted,
+			      struct file *file)
 {
+	unsigned long slot = (granted->addr - agnocast_pool_base) / agnocast_pool_size;
+	struct agnocast_mempool *pool = proc->ns->slots[slot];
+
 	lockdep_assert_held(&proc->ns->lock);
-	fd_install(fd, get_file(pool->file));
-	if (!__test_and_set_bit(pool->slot, proc->given))
+	if (pool && pool->file == file && !__test_and_set_bit(slot, proc->given))
 		proc->nr_given++;
 }
 

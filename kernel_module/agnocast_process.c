@@ -62,12 +62,14 @@ static void agnocast_queue_exit_records(struct agnocast_proc *proc)
 {
 	struct agnocast_ns *ns = proc->ns;
 	struct agnocast_subscriber *sub;
+	struct agnocast_endpoint *ep;
 
-	list_for_each_entry(sub, &proc->subscribers, proc_node) {
+	list_for_each_entry(ep, &proc->subscribers, proc_node) {
+		sub = agnocast_to_subscriber(ep);
 		if (!sub->exit_record)
 			continue;
 		agnocast_exit_record_queue(ns, sub->exit_record, AGNOCAST_EXIT_QUEUE, proc->pid,
-					   sub->id, sub->topic->name);
+					   ep->id, ep->topic->name);
 		sub->exit_record = NULL;
 	}
 	agnocast_exit_record_queue(ns, proc->exit_record, AGNOCAST_EXIT_PROCESS, proc->pid, 0,
@@ -254,7 +256,7 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 	INIT_LIST_HEAD(&proc->publishers);
 	INIT_LIST_HEAD(&proc->subscribers);
 	INIT_LIST_HEAD(&proc->reclaim);
-	INIT_LIST_HEAD(&proc->spare_msgs);
+	INIT_LIST_HEAD(&proc->spare_entries);
 	INIT_LIST_HEAD(&proc->spare_held);
 	list_add_tail(&proc->ns_node, &ns->procs);
 	ns->nr_procs++;

@@ -13,43 +13,42 @@
  * usual release, of the oldest held entry, finds it first.
  *
  * This file never touches user memory and never calls back into topics or
- * ioctls; every function runs under the namespace lock (agnocast_ns.lock).
+ * ioctls.  Everything about a topic's entries runs under the topic's lock
+ * (the namespace lock held at least for read); a process's reclaim list is
+ * under its reclaim_lock, since entries of any topic end up there.
  */
 #include <linux/slab.h>
 #include <linux/string.h>
 
 #include "agnocast_internal.h"
 
-/* Keeps @node on @spares for reuse unless @nr spares are kept already. */
-static bool agnocast_spare_keep(struct list_head *node, struct list_head *spares,
-				unsigned int *nr)
+static struct kmem_cache *agnocast_entry_cache;
+static struct kmem_cache *agnocast_held_cache;
+
+int agnocast_entry_init(void)
 {
-	if (*nr >= AGNOCAST_SPARES_MAX)
-		return false;
-	list_add(node, spares);
-	(*nr)++;
-	return true;
+	agnocast_entry_cache = KMEM_CACHE(agnocast_topic_entry, SLAB_ACCOUNT);
+	agnocast_held_cache = KMEM_CACHE(agnocast_held, SLAB_ACCOUNT);
+	if (agnocast_entry_cache && agnocast_held_cache)
+		return 0;
+	agnocast_entry_exit();
+	return -ENOMEM;
 }
 
-struct agnocast_topic_entry *agnocast_entry_alloc(struct agnocast_proc *proc)
+void agnocast_entry_exit(void)
 {
-	struct agnocast_topic_entry *entry;
-
-	lockdep_assert_held(&proc->ns->lock);
-	if (list_empty(&proc->spare_entries))
-		return kzalloc(sizeof(*entry), GFP_KERNEL_ACCOUNT);
-	entry = list_first_entry(&proc->spare_entries, struct agnocast_topic_entry, node);
-	list_del(&entry->node);
-	proc->nr_spare_entries--;
-	memset(entry, 0, sizeof(*entry));
-	return entry;
+	kmem_cache_destroy(agnocast_held_cache);
+	kmem_cache_destroy(agnocast_entry_cache);
 }
 
-void agnocast_entry_free(struct agnocast_proc *proc, struct agnocast_topic_entry *entry)
+struct agnocast_topic_entry *agnocast_entry_alloc(void)
 {
-	lockdep_assert_held(&proc->ns->lock);
-	if (!agnocast_spare_keep(&entry->node, &proc->spare_entries, &proc->nr_spare_entries))
-		kfree(entry);
+	return kmem_cache_zalloc(agnocast_entry_cache, GFP_KERNEL_ACCOUNT);
+}
+
+void agnocast_entry_free(struct agnocast_topic_entry *entry)
+{
+	kmem_cache_free(agnocast_entry_cache, entry);
 }
 
 static void agnocast_entry_unref(struct agnocast_topic_entry *entry)
@@ -58,19 +57,23 @@ static void agnocast_entry_unref(struct agnocast_topic_entry *entry)
 	struct agnocast_proc *owner = pool->owner;
 	struct agnocast_topic *topic = entry->topic;
 
-	lockdep_assert_held(&topic->ns->lock);
+	lockdep_assert_held(&topic->lock);
 	if (WARN_ON_ONCE(!entry->refs) || --entry->refs)
 		return;
 	list_del(&entry->node);
 	topic->nr_entries--;
-	pool->entries--;
 	if (owner) {
+		atomic_long_dec(&pool->entries);
+		spin_lock(&owner->reclaim_lock);
 		list_add_tail(&entry->node, &owner->reclaim);
 		owner->nr_reclaim++;
-	} else {
-		kfree(entry);
-		agnocast_pool_maybe_free(topic->ns, pool);
+		spin_unlock(&owner->reclaim_lock);
+		return;
 	}
+	agnocast_entry_free(entry);
+	/* An ownerless pool may be free now; agnocast_leave() collects it. */
+	if (atomic_long_dec_and_test(&pool->entries))
+		WRITE_ONCE(topic->ns->collect_pools, true);
 }
 
 static void agnocast_entry_leave_window(struct agnocast_topic_entry *entry)
@@ -126,7 +129,7 @@ void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topi
 	struct agnocast_topic *topic = pub->ep.topic;
 	struct agnocast_endpoint *ep;
 
-	lockdep_assert_held(&topic->ns->lock);
+	lockdep_assert_held(&topic->lock);
 	entry->topic = topic;
 	entry->publisher = pub;
 	entry->pool = pool;
@@ -136,7 +139,7 @@ void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topi
 	entry->refs = 1;
 	list_add_tail(&entry->node, &topic->entries);
 	topic->nr_entries++;
-	pool->entries++;
+	atomic_long_inc(&pool->entries);
 	list_add_tail(&entry->window_node, &pub->window);
 	pub->window_len++;
 	pub->published++;
@@ -189,45 +192,31 @@ void agnocast_sub_drop_entries(struct agnocast_subscriber *sub)
 		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
 	list_for_each_entry_safe(held, tmp, &sub->held, node) {
 		agnocast_entry_unref(held->entry);
-		kfree(held);
+		kmem_cache_free(agnocast_held_cache, held);
 	}
 	INIT_LIST_HEAD(&sub->held);
 	sub->nr_held = 0;
 }
 
-static void agnocast_held_free(struct agnocast_proc *proc, struct agnocast_held *held)
-{
-	if (!agnocast_spare_keep(&held->node, &proc->spare_held, &proc->nr_spare_held))
-		kfree(held);
-}
-
-void agnocast_held_free_list(struct agnocast_proc *proc, struct list_head *list)
+void agnocast_held_free_list(struct list_head *list)
 {
 	struct agnocast_held *held, *tmp;
 
-	lockdep_assert_held(&proc->ns->lock);
-	list_for_each_entry_safe(held, tmp, list, node) {
-		list_del(&held->node);
-		agnocast_held_free(proc, held);
-	}
+	list_for_each_entry_safe(held, tmp, list, node)
+		kmem_cache_free(agnocast_held_cache, held);
+	INIT_LIST_HEAD(list);
 }
 
-/* Fills @list with @n held records, spares first, so that holding cannot fail. */
-int agnocast_held_alloc_list(struct agnocast_proc *proc, struct list_head *list, u32 n)
+/* Fills @list with @n held records, so that holding cannot fail. */
+int agnocast_held_alloc_list(struct list_head *list, u32 n)
 {
 	struct agnocast_held *held;
 
-	lockdep_assert_held(&proc->ns->lock);
 	INIT_LIST_HEAD(list);
-	for (; n && proc->nr_spare_held; n--) {
-		held = list_first_entry(&proc->spare_held, struct agnocast_held, node);
-		list_move(&held->node, list);
-		proc->nr_spare_held--;
-	}
 	while (n--) {
-		held = kzalloc(sizeof(*held), GFP_KERNEL_ACCOUNT);
+		held = kmem_cache_alloc(agnocast_held_cache, GFP_KERNEL_ACCOUNT);
 		if (!held) {
-			agnocast_held_free_list(proc, list);
+			agnocast_held_free_list(list);
 			return -ENOMEM;
 		}
 		list_add(&held->node, list);
@@ -260,8 +249,7 @@ void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct list_head 
 	agnocast_sub_hold_oldest(sub, spare);
 }
 
-/* Held entries are in receive order: the usual release finds the first. */
-struct agnocast_held *agnocast_sub_find_held(struct agnocast_subscriber *sub, u64 entry_id)
+static struct agnocast_held *agnocast_sub_find_held(struct agnocast_subscriber *sub, u64 entry_id)
 {
 	struct agnocast_held *held;
 
@@ -272,12 +260,32 @@ struct agnocast_held *agnocast_sub_find_held(struct agnocast_subscriber *sub, u6
 	return NULL;
 }
 
-void agnocast_sub_release(struct agnocast_subscriber *sub, struct agnocast_held *held)
+/*
+ * Drops @sub's references to the @n entries @ids, all or none (-ENOENT when
+ * one is not held, or listed twice).  Held entries are in receive order and
+ * a subscriber releases mostly its oldest, so each is usually found first.
+ */
+int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n)
 {
-	list_del(&held->node);
-	sub->nr_held--;
-	agnocast_entry_unref(held->entry);
-	agnocast_held_free(sub->ep.proc, held);
+	struct agnocast_held *held, *tmp;
+	LIST_HEAD(found);
+	u32 i;
+
+	lockdep_assert_held(&sub->ep.topic->lock);
+	for (i = 0; i < n; i++) {
+		held = agnocast_sub_find_held(sub, ids[i]);
+		if (!held) {
+			list_splice(&found, &sub->held);
+			return -ENOENT;
+		}
+		list_move_tail(&held->node, &found);
+	}
+	list_for_each_entry_safe(held, tmp, &found, node) {
+		sub->nr_held--;
+		agnocast_entry_unref(held->entry);
+		kmem_cache_free(agnocast_held_cache, held);
+	}
+	return 0;
 }
 
 /*
@@ -305,73 +313,64 @@ u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *
 	return shed;
 }
 
-/* Copies up to @max reclaimable addresses, oldest first, to @addrs. */
-u32 agnocast_reclaim_peek(struct agnocast_proc *proc, u64 *addrs, u32 max)
+/*
+ * Takes up to @max reclaimable addresses, oldest first, into @addrs for
+ * delivery to the owner; @pending is how many are left.
+ */
+u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *pending)
 {
-	struct agnocast_topic_entry *entry;
+	struct agnocast_topic_entry *entry, *tmp;
+	LIST_HEAD(taken);
 	u32 n = 0;
 
-	lockdep_assert_held(&proc->ns->lock);
-	list_for_each_entry(entry, &proc->reclaim, node) {
+	spin_lock(&proc->reclaim_lock);
+	list_for_each_entry_safe(entry, tmp, &proc->reclaim, node) {
 		if (n == max)
 			break;
 		addrs[n++] = entry->addr;
+		list_move_tail(&entry->node, &taken);
 	}
+	proc->nr_reclaim -= n;
+	*pending = proc->nr_reclaim;
+	spin_unlock(&proc->reclaim_lock);
+	list_for_each_entry_safe(entry, tmp, &taken, node)
+		agnocast_entry_free(entry);
 	return n;
 }
 
-/* Forgets the @n oldest reclaimable entries, delivered to the owner. */
-void agnocast_reclaim_forget(struct agnocast_proc *proc, u32 n)
-{
-	struct agnocast_topic_entry *entry, *tmp;
-
-	lockdep_assert_held(&proc->ns->lock);
-	list_for_each_entry_safe(entry, tmp, &proc->reclaim, node) {
-		if (!n--)
-			break;
-		list_del(&entry->node);
-		proc->nr_reclaim--;
-		agnocast_entry_free(proc, entry);
-	}
-}
-
 /*
- * Puts back addresses forgotten by a call that could not deliver them, as
- * the oldest reclaimable ones.  Only the address matters on the reclaim
- * list; an address is lost only if no memory is left to remember it.
+ * Puts back addresses taken by a call that could not deliver them, as the
+ * oldest reclaimable ones.  Only the address matters on the reclaim list;
+ * an address is lost only if no memory is left to remember it.
  */
 void agnocast_reclaim_return(struct agnocast_proc *proc, const u64 *addrs, u32 n)
 {
 	struct agnocast_topic_entry *entry;
+	LIST_HEAD(back);
+	u32 i, kept = 0;
 
-	lockdep_assert_held(&proc->ns->lock);
-	while (n--) {
-		entry = agnocast_entry_alloc(proc);
+	for (i = 0; i < n; i++) {
+		entry = agnocast_entry_alloc();
 		if (!entry)
 			continue;
-		entry->addr = addrs[n];
-		list_add(&entry->node, &proc->reclaim);
-		proc->nr_reclaim++;
+		entry->addr = addrs[i];
+		list_add_tail(&entry->node, &back);
+		kept++;
 	}
+	spin_lock(&proc->reclaim_lock);
+	list_splice(&back, &proc->reclaim);
+	proc->nr_reclaim += kept;
+	spin_unlock(&proc->reclaim_lock);
 }
 
-/* Teardown: frees the reclaim list and the spares. */
+/* Teardown (namespace lock held for write): frees the reclaim list. */
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc)
 {
 	struct agnocast_topic_entry *entry, *tmp;
-	struct agnocast_held *held, *htmp;
 
-	lockdep_assert_held(&proc->ns->lock);
+	lockdep_assert_held_write(&proc->ns->lock);
 	list_for_each_entry_safe(entry, tmp, &proc->reclaim, node)
-		kfree(entry);
+		agnocast_entry_free(entry);
 	INIT_LIST_HEAD(&proc->reclaim);
 	proc->nr_reclaim = 0;
-	list_for_each_entry_safe(entry, tmp, &proc->spare_entries, node)
-		kfree(entry);
-	INIT_LIST_HEAD(&proc->spare_entries);
-	proc->nr_spare_entries = 0;
-	list_for_each_entry_safe(held, htmp, &proc->spare_held, node)
-		kfree(held);
-	INIT_LIST_HEAD(&proc->spare_held);
-	proc->nr_spare_held = 0;
 }

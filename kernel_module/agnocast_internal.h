@@ -2,14 +2,29 @@
 /*
  * agnocast: state shared between the module's files.
  *
- * Locking overview (outermost first; see agnocast_ns.c):
- *   1. agnocast_ns_list_lock  (mutex)    the list of namespace states
- *   1a. agnocast_ns.exit_read_lock (mutex) readers of exit records only
- *   2. agnocast_ns.lock       (mutex)    everything inside one namespace
- *   3. agnocast_proc_table_lock (spinlock) tgid -> process lookup; also taken
- *                                        from the process-exit tracepoint
- * receive_fd() and copy_{to,from}_user() may sleep: they run under 2 at most,
- * never under 3.
+ * Locking, outermost first.  Every field below says which lock protects it.
+ *
+ *   agnocast_ns_list_lock (mutex)       the list of namespace states
+ *   agnocast_ns.exit_read_lock (mutex)  serialises readers of exit records
+ *   agnocast_ns.lock (rw_semaphore)     the namespace's structure.  Taken for
+ *       write (killably) by what changes it: registering and tearing down
+ *       processes, adding and removing endpoints (and so topics), attaching
+ *       and freeing pools, setting the policy.  Taken for read (killably) by
+ *       everything else: the data path (PUBLISH, RECLAIM, RECEIVE, TAKE,
+ *       RELEASE, SHED) and introspection.  Holding it for write excludes
+ *       every other call of the namespace, so nothing below is then needed.
+ *   agnocast_topic.lock (mutex)         one topic's entries, windows,
+ *       subscribers' rings and held entries, and counters: the data path of
+ *       different topics never contends.  Never two at once.
+ *   agnocast_proc.reclaim_lock (spinlock) a process's reclaim list, which
+ *       every topic's data path may add to
+ *   agnocast_ns.exit_lock (spinlock)    the namespace's exit record list
+ *   agnocast_proc_table_lock (raw spinlock) changes to the tgid table,
+ *       also taken from the exit and exec tracepoints; lookups use RCU
+ *
+ * No user copy and no descriptor install happens under agnocast_ns.lock or
+ * below: arguments are copied in before, answers staged and copied out
+ * after, descriptors installed in between with no lock held.
  */
 #ifndef _AGNOCAST_INTERNAL_H
 #define _AGNOCAST_INTERNAL_H
@@ -18,6 +33,8 @@
 #include <linux/idr.h>
 #include <linux/list.h>
 #include <linux/mutex.h>
+#include <linux/rwsem.h>
+#include <linux/spinlock.h>
 #include <linux/pid.h>
 #include <linux/slab.h>
 #include <linux/types.h>
@@ -30,8 +47,6 @@
 
 /* Unreferenced id spaces kept so that topic_local_ids are not reused soon. */
 #define AGNOCAST_DORMANT_ID_SPACES_MAX 1024
-/* Spare messages and held records a process keeps of each kind. */
-#define AGNOCAST_SPARES_MAX 16
 
 struct ipc_namespace;
 struct file;
@@ -63,10 +78,12 @@ struct agnocast_ns {
 	struct super_block *mq_sb;
 
 	struct mutex exit_read_lock;	/* serialises readers of exit records */
-	struct mutex lock;
-	/* Everything below is protected by @lock. */
+	struct rw_semaphore lock;
+	/* Everything below is protected by @lock (written under it for write). */
 	unsigned long *slot_map;	/* pool_count bits: slot in use */
 	struct agnocast_mempool **slots;	/* pool_count entries */
+	struct list_head orphan_pools;	/* pools whose owner is gone */
+	bool collect_pools;		/* set under @lock for read: one may be free */
 	struct list_head procs;
 	unsigned int nr_procs;
 	DECLARE_HASHTABLE(topics, 8);
@@ -75,30 +92,34 @@ struct agnocast_ns {
 	DECLARE_HASHTABLE(id_spaces, 8);
 	struct list_head dormant_id_spaces; /* oldest first */
 	unsigned int nr_dormant_id_spaces;
+	spinlock_t exit_lock;
+	/* Protected by @exit_lock. */
 	struct list_head exit_records;	/* oldest first */
 	unsigned int nr_exit_records;	/* read without @lock by poll */
 	u64 exit_records_lost;		/* discarded, not yet reported; ditto */
 	u64 exit_records_seq;
 	wait_queue_head_t exit_wait;
-	struct agnocast_policy_state *policy;	/* NULL: everyone may */
+	struct agnocast_policy_state *policy;	/* NULL: everyone may; ns->lock */
 };
 
 /* A publisher's shared-memory pool, occupying one slot. */
 struct agnocast_mempool {
-	/* All fields protected by the namespace lock. */
+	/* Written under the namespace lock for write but @entries. */
 	unsigned int slot;
 	u64 addr;
 	u64 size;
 	struct file *file;		/* read-only reopening; NULL until attached */
 	struct agnocast_proc *owner;	/* NULL once the owner is gone */
+	struct list_head orphan_node;	/* on ns->orphan_pools once it is */
 	struct pid *owner_pid;
-	unsigned long entries;		/* live entries inside the pool */
+	atomic_long_t entries;		/* live entries inside the pool */
 };
 
 /* A registered process. */
 struct agnocast_proc {
-	struct hlist_node table_node;	/* protected by agnocast_proc_table_lock */
-	bool dying;			/* protected by agnocast_proc_table_lock */
+	struct hlist_node table_node;	/* written under agnocast_proc_table_lock */
+	struct rcu_head rcu;
+	bool dying;			/* written under agnocast_proc_table_lock */
 	pid_t tgid;			/* init-namespace number; the table key */
 	u64 exec_id;
 	kuid_t uid;			/* effective uid at registration */
@@ -108,22 +129,19 @@ struct agnocast_proc {
 	/* Queued when the process dies; NULL after. Protected by ns->lock. */
 	struct agnocast_exit_record_node *exit_record;
 
-	/* Protected by ns->lock. */
+	/* Written under ns->lock for write. */
 	struct list_head ns_node;
 	struct agnocast_mempool *pool;
 	struct list_head publishers;	/* of agnocast_endpoint.proc_node */
 	struct list_head subscribers;	/* ditto */
 	unsigned int nr_publishers;
 	unsigned int nr_subscribers;
-	unsigned long *given;		/* pool_count bits: live pools handed over */
-	unsigned int nr_given;
+	/* pool_count bits: live pools handed over; atomic bit operations. */
+	unsigned long *given;
+	spinlock_t reclaim_lock;
+	/* Protected by @reclaim_lock. */
 	struct list_head reclaim;	/* freed entries of this process's pool */
 	unsigned int nr_reclaim;
-	/* Freed bookkeeping kept for reuse, so publish and receive rarely allocate. */
-	struct list_head spare_entries;
-	struct list_head spare_held;
-	unsigned int nr_spare_entries;
-	unsigned int nr_spare_held;
 };
 
 /* Names equal after mangling share one topic_local_id counter. */
@@ -135,6 +153,7 @@ struct agnocast_id_space {
 	char mangled[AGNOCAST_TOPIC_NAME_MAX];
 };
 
+/* Written under ns->lock for write, but what @lock protects. */
 struct agnocast_topic {
 	struct hlist_node hash_node;
 	struct agnocast_ns *ns;
@@ -146,6 +165,8 @@ struct agnocast_topic {
 	unsigned int nr_publishers;
 	unsigned int nr_subscribers;
 	unsigned int nr_callback_subscribers;
+	struct mutex lock;
+	/* Protected by @lock, with the windows, rings and held entries. */
 	struct list_head entries;	/* by id */
 	unsigned int nr_entries;
 	u64 next_entry_id;
@@ -157,7 +178,11 @@ struct agnocast_topic {
 	char name[AGNOCAST_TOPIC_NAME_MAX];
 };
 
-/* What publishers and subscribers share: found by id in topic->endpoints. */
+/*
+ * What publishers and subscribers share: found by id in topic->endpoints.
+ * The head is written under ns->lock for write; the rest of a publisher and
+ * a subscriber under topic->lock.
+ */
 struct agnocast_endpoint {
 	struct list_head topic_node;	/* on topic->publishers or ->subscribers */
 	struct list_head proc_node;	/* on proc->publishers or ->subscribers */
@@ -188,11 +213,11 @@ struct agnocast_subscriber {
 	u32 nr_held;
 	u64 received;
 	u64 dropped;
-	/* Callback subscribers: queued when the process dies, NULL after. */
+	/* Callback subscribers: queued when the process dies (ns->lock). */
 	struct agnocast_exit_record_node *exit_record;
 };
 
-/* One published message of a topic; the UAPI's entry. */
+/* One published message of a topic; the UAPI's entry.  topic->lock. */
 struct agnocast_topic_entry {
 	/* On topic->entries while live, on the owner's reclaim list after. */
 	struct list_head node;
@@ -235,11 +260,18 @@ static inline void agnocast_exit_record_free(struct agnocast_exit_record_node *r
 	kfree(rec);
 }
 
+/* An open /dev/agnocast. */
+struct agnocast_file {
+	struct agnocast_ns *ns;		/* the opener's namespace, with a user reference */
+	bool may_read_exit_records;	/* decided at open */
+};
+
 /* The calling process's view, valid between agnocast_enter/agnocast_leave. */
 struct agnocast_ctx {
 	struct agnocast_ns *ns;
 	struct agnocast_proc *proc;	/* NULL if not registered */
 	bool ns_from_file;		/* ns is the open file's: no reference of our own */
+	bool write;			/* ns->lock is held for write */
 };
 
 /* agnocast_ns.c */
@@ -258,7 +290,8 @@ ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
 				   size_t count, bool nonblock);
 
 /* agnocast_process.c */
-int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered);
+int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered,
+		   bool write);
 void agnocast_leave(struct agnocast_ctx *ctx);
 int agnocast_process_init(void);
 void agnocast_process_exit(void);
@@ -275,7 +308,8 @@ int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg);
 struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
 					    struct agnocast_proc *owner);
 int agnocast_pool_attach(struct agnocast_mempool *pool, int fd);
-void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool);
+void agnocast_pool_orphan(struct agnocast_ns *ns, struct agnocast_mempool *pool);
+void agnocast_pools_collect(struct agnocast_ns *ns);
 bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
 				const struct agnocast_mempool *pool);
 void agnocast_pool_describe(struct agnocast_mempool *pool, struct agnocast_pool *out);
@@ -283,9 +317,11 @@ void agnocast_pool_mark_given(struct agnocast_proc *proc, const struct agnocast_
 			      struct file *file);
 void agnocast_pool_drop_given(struct agnocast_proc *proc);
 
-/* agnocast_entry.c: the entry engine; no user copies, namespace lock held. */
-struct agnocast_topic_entry *agnocast_entry_alloc(struct agnocast_proc *proc);
-void agnocast_entry_free(struct agnocast_proc *proc, struct agnocast_topic_entry *entry);
+/* agnocast_entry.c: the entry engine; no user copies, topic->lock held. */
+int agnocast_entry_init(void);
+void agnocast_entry_exit(void);
+struct agnocast_topic_entry *agnocast_entry_alloc(void);
+void agnocast_entry_free(struct agnocast_topic_entry *entry);
 void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
 			    struct agnocast_mempool *pool, u64 addr, u64 bytes);
 void agnocast_publisher_drop_window(struct agnocast_publisher *pub);
@@ -293,15 +329,13 @@ struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subsc
 						     u32 i);
 void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
-int agnocast_held_alloc_list(struct agnocast_proc *proc, struct list_head *list, u32 n);
-void agnocast_held_free_list(struct agnocast_proc *proc, struct list_head *list);
+int agnocast_held_alloc_list(struct list_head *list, u32 n);
+void agnocast_held_free_list(struct list_head *list);
 void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub, struct list_head *spare);
 void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct list_head *spare);
-struct agnocast_held *agnocast_sub_find_held(struct agnocast_subscriber *sub, u64 entry_id);
-void agnocast_sub_release(struct agnocast_subscriber *sub, struct agnocast_held *held);
+int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n);
 u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool);
-u32 agnocast_reclaim_peek(struct agnocast_proc *proc, u64 *addrs, u32 max);
-void agnocast_reclaim_forget(struct agnocast_proc *proc, u32 n);
+u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *pending);
 void agnocast_reclaim_return(struct agnocast_proc *proc, const u64 *addrs, u32 n);
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
 

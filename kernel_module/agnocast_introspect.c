@@ -7,6 +7,7 @@
  * namespace does.  Each call builds its answer in kernel memory under the
  * namespace lock (agnocast_ns.lock) and copies it out after dropping it.
  */
+#include <linux/bitmap.h>
 #include <linux/cred.h>
 #include <linux/mm.h>
 #include <linux/overflow.h>
@@ -39,7 +40,9 @@ int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		return ret;
 
@@ -143,6 +146,8 @@ static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_top
 	answer->subs = kvcalloc(answer->nsub, sizeof(*answer->subs), GFP_KERNEL_ACCOUNT);
 	if ((answer->npub && !answer->pubs) || (answer->nsub && !answer->subs))
 		return -ENOMEM;
+	/* Counters and rings belong to the data path, under the topic's lock. */
+	mutex_lock(&topic->lock);
 	i = 0;
 	list_for_each_entry(ep, &topic->publishers, topic_node) {
 		if (i == answer->npub)
@@ -159,6 +164,7 @@ static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_top
 	arg->publisher_total = topic->nr_publishers;
 	arg->subscriber_total = topic->nr_subscribers;
 	arg->entries = topic->nr_entries;
+	mutex_unlock(&topic->lock);
 	memcpy(arg->type_name, topic->type_name, sizeof(arg->type_name));
 	arg->type_hash = topic->type_hash;
 	arg->schema_size = topic->schema_size;
@@ -178,7 +184,7 @@ int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EINVAL;
 	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
 		goto out_free;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		goto out_free;
 	ret = agnocast_topic_info_build(ctx.ns, arg, &answer);
@@ -218,7 +224,9 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		return ret;
 
@@ -235,7 +243,7 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 		info->pid = pid_nr_ns(proc->pid, pid_ns);
 		info->publishers = proc->nr_publishers;
 		info->subscribers = proc->nr_subscribers;
-		info->pools_mapped = proc->nr_given;
+		info->pools_mapped = bitmap_weight(proc->given, agnocast_pool_count);
 		info->pool_addr = proc->pool->addr;
 		info->pool_size = proc->pool->size;
 	}
@@ -270,7 +278,7 @@ int agnocast_topic_schema(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EINVAL;
 	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
 		goto out_free_arg;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		goto out_free_arg;
 	topic = agnocast_topic_find(ctx.ns, arg->name);

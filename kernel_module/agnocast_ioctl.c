@@ -10,6 +10,7 @@
 #include <linux/file.h>
 #include <linux/version.h>
 #include <linux/minmax.h>
+#include <linux/pagemap.h>
 #include <linux/slab.h>
 #include <linux/string.h>
 #include <linux/uaccess.h>
@@ -18,11 +19,10 @@
 
 /* Entries a RECEIVE handles without allocating; 4 keeps the frame small. */
 #define AGNOCAST_RECEIVE_SMALL 4
-/* Most entries and pools one RECEIVE returns; remaining counts the rest. */
-#define AGNOCAST_RECEIVE_ENTRIES_MAX 256
-#define AGNOCAST_RECEIVE_POOLS_MAX 8
-/* Reclaimable addresses one PUBLISH or RECLAIM returns at most. */
-#define AGNOCAST_RECLAIM_BATCH 32
+/* Subscribers a PUBLISH wakes without allocating. */
+#define AGNOCAST_WAKE_SMALL 16
+/* Entry ids a RELEASE or RECEIVE releases without allocating. */
+#define AGNOCAST_RELEASE_SMALL 8
 
 static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 				 bool publisher)
@@ -51,7 +51,7 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 			goto out_free_arg;
 	}
 
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, true);
 	if (ret)
 		goto out_free_arg;
 	ret = agnocast_policy_check(ctx.ns, arg->topic, publisher);
@@ -122,7 +122,7 @@ static int agnocast_remove_endpoint(struct agnocast_ns *file_ns, void __user *ua
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, true);
 	if (ret)
 		return ret;
 	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.id, publisher, &ep);
@@ -155,7 +155,11 @@ int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
  */
 static int agnocast_out_writable(u64 ubuf, size_t bytes)
 {
-	return clear_user(u64_to_user_ptr(ubuf), bytes) ? -EFAULT : 0;
+	char __user *p = u64_to_user_ptr(ubuf);
+
+	if (!bytes)
+		return 0;
+	return access_ok(p, bytes) && !fault_in_safe_writeable(p, bytes) ? 0 : -EFAULT;
 }
 
 /* Writes an answer after commit; a failure loses only the answer (see above). */
@@ -164,29 +168,42 @@ static bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
 	return !copy_to_user(to, from, bytes);
 }
 
+/*
+ * An unwritable output is -EFAULT, but an unregistered caller learns that
+ * first, as it would if the buffers were fine.
+ */
+static int agnocast_unwritable(struct agnocast_ns *file_ns)
+{
+	struct agnocast_ctx ctx;
+	int ret;
+
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		return ret;
+	agnocast_leave(&ctx);
+	return -EFAULT;
+}
+
 /* Probes a field of the argument for writing, keeping its value. */
 #define agnocast_arg_writable(ufield, value) (put_user(value, ufield) ? -EFAULT : 0)
 
-static int agnocast_reclaim_out(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *count,
-				u32 *pending)
-{
-	*count = agnocast_reclaim_peek(proc, addrs, max);
-	agnocast_reclaim_forget(proc, *count);
-	*pending = proc->nr_reclaim;
-	return 0;
-}
-
-/* Addresses whose copy-out failed go back to the owner's reclaim list. */
+/*
+ * Addresses whose copy-out failed go back to the caller's reclaim list, if
+ * the caller is still registered with the pool they belong to.
+ */
 static void agnocast_reclaim_copy_out(struct agnocast_ns *file_ns, u64 ubuf, const u64 *addrs,
 				      u32 n)
 {
+	struct agnocast_mempool *pool;
 	struct agnocast_ctx ctx;
 
 	if (!n || agnocast_answer_out(u64_to_user_ptr(ubuf), addrs, n * sizeof(*addrs)))
 		return;
-	if (agnocast_enter(&ctx, file_ns, true))
+	if (agnocast_enter(&ctx, file_ns, true, false))
 		return;
-	agnocast_reclaim_return(ctx.proc, addrs, n);
+	pool = ctx.proc->pool;
+	if (addrs[0] >= pool->addr && addrs[0] - pool->addr < pool->size)
+		agnocast_reclaim_return(ctx.proc, addrs, n);
 	agnocast_leave(&ctx);
 }
 
@@ -194,7 +211,7 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_publish __user *upublish = uarg;
 	u64 reclaim[AGNOCAST_RECLAIM_BATCH];
-	u32 wake_small[AGNOCAST_RECEIVE_SMALL];
+	u32 wake_small[AGNOCAST_WAKE_SMALL];
 	struct agnocast_topic_entry *entry;
 	struct agnocast_publish arg;
 	struct agnocast_endpoint *ep;
@@ -215,16 +232,11 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	if (agnocast_out_writable(arg.wake_ids, wake_max * sizeof(u32)) ||
 	    agnocast_out_writable(arg.reclaim, reclaim_max * sizeof(u64)) ||
 	    agnocast_arg_writable(&upublish->reserved, 0))
-		return -EFAULT;
-	if (wake_max > ARRAY_SIZE(wake_small)) {
-		wake = kvmalloc_array(wake_max, sizeof(*wake), GFP_KERNEL_ACCOUNT);
-		if (!wake)
-			return -ENOMEM;
-	}
+		return agnocast_unwritable(file_ns);
 
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
 	if (ret)
-		goto out_free;
+		return ret;
 	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.publisher_id, true, &ep);
 	if (ret)
 		goto out_leave;
@@ -241,7 +253,13 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	if (arg.wake_capacity < topic->nr_callback_subscribers)
 		goto out_leave;
 	ret = -ENOMEM;
-	entry = agnocast_entry_alloc(ctx.proc);
+	if (topic->nr_callback_subscribers > ARRAY_SIZE(wake_small)) {
+		wake = kvmalloc_array(topic->nr_callback_subscribers, sizeof(*wake),
+				      GFP_KERNEL_ACCOUNT);
+		if (!wake)
+			goto out_leave;
+	}
+	entry = agnocast_entry_alloc();
 	if (!entry)
 		goto out_leave;
 
@@ -250,11 +268,13 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 		if (!(ep->flags & AGNOCAST_POLLING))
 			wake[wake_count++] = ep->id;
 	}
+	mutex_lock(&topic->lock);
 	agnocast_entry_publish(pub, entry, pool, arg.addr, arg.bytes);
 	arg.entry_id = entry->id;
+	mutex_unlock(&topic->lock);
 	arg.wake_count = wake_count;
-	agnocast_reclaim_out(ctx.proc, reclaim, reclaim_max, &arg.reclaim_count,
-			     &arg.reclaim_pending);
+	arg.reclaim_count = agnocast_reclaim_take(ctx.proc, reclaim, reclaim_max,
+						  &arg.reclaim_pending);
 	ret = 0;
 out_leave:
 	agnocast_leave(&ctx);
@@ -264,7 +284,6 @@ out_leave:
 					wake_count * sizeof(*wake)))
 			agnocast_answer_out(uarg, &arg, sizeof(arg));
 	}
-out_free:
 	if (wake != wake_small)
 		kvfree(wake);
 	return ret;
@@ -286,15 +305,38 @@ int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
 	reclaim_max = min_t(u32, arg.reclaim_capacity, AGNOCAST_RECLAIM_BATCH);
 	if (agnocast_out_writable(arg.reclaim, reclaim_max * sizeof(u64)) ||
 	    agnocast_arg_writable(&ureclaim->reserved, 0))
-		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, true);
+		return agnocast_unwritable(file_ns);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
 	if (ret)
 		return ret;
-	agnocast_reclaim_out(ctx.proc, reclaim, reclaim_max, &arg.reclaim_count,
-			     &arg.reclaim_pending);
+	arg.reclaim_count = agnocast_reclaim_take(ctx.proc, reclaim, reclaim_max,
+						  &arg.reclaim_pending);
 	agnocast_leave(&ctx);
 	agnocast_reclaim_copy_out(file_ns, arg.reclaim, reclaim, arg.reclaim_count);
 	agnocast_answer_out(uarg, &arg, sizeof(arg));
+	return 0;
+}
+
+/*
+ * Copies in the @count entry ids at @uids, into @small when they fit, else
+ * into memory to kvfree() when *ids != small.
+ */
+static int agnocast_release_ids_in(u64 uids, u32 count, u64 *small, u64 **ids)
+{
+	*ids = small;
+	if (count > AGNOCAST_RELEASE_MAX)
+		return -EINVAL;
+	if (count > AGNOCAST_RELEASE_SMALL) {
+		*ids = kvmalloc_array(count, sizeof(u64), GFP_KERNEL_ACCOUNT);
+		if (!*ids)
+			return -ENOMEM;
+	}
+	if (copy_from_user(*ids, u64_to_user_ptr(uids), count * sizeof(u64))) {
+		if (*ids != small)
+			kvfree(*ids);
+		*ids = small;
+		return -EFAULT;
+	}
 	return 0;
 }
 
@@ -320,6 +362,9 @@ struct agnocast_grants {
 	struct agnocast_pool out[AGNOCAST_RECEIVE_POOLS_MAX];
 	u32 count;
 	u32 capacity;
+	/* TAKE: a grant replaced by another, to close and put unlocked. */
+	struct file *stale_file;
+	int stale_fd;
 };
 
 static bool agnocast_grants_has(const struct agnocast_grants *grants,
@@ -352,6 +397,21 @@ static bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_
 	return true;
 }
 
+/*
+ * TAKE's one grant: the installed descriptor of a pool the newest entry no
+ * longer needs is closed once no lock is held (agnocast_grants_install()).
+ */
+static void agnocast_grants_add_over(struct agnocast_grants *grants,
+				     struct agnocast_mempool *pool)
+{
+	if (grants->count) {
+		grants->stale_fd = grants->out[0].fd;
+		grants->stale_file = grants->files[0];
+		grants->count = 0;
+	}
+	agnocast_grants_add(grants, pool);
+}
+
 static int agnocast_receive_fd(struct file *file)
 {
 #if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 8, 0)
@@ -370,6 +430,11 @@ static int agnocast_grants_install(struct agnocast_grants *grants, u32 from)
 	u32 i;
 	int fd;
 
+	if (grants->stale_file) {
+		close_fd(grants->stale_fd);
+		fput(grants->stale_file);
+		grants->stale_file = NULL;
+	}
 	for (i = from; i < grants->count; i++) {
 		fd = agnocast_receive_fd(grants->files[i]);
 		if (fd < 0)
@@ -420,46 +485,61 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 	struct agnocast_entry entries_small[AGNOCAST_RECEIVE_SMALL];
 	struct agnocast_receive __user *ureceive = uarg;
 	struct agnocast_entry *entries = entries_small;
+	u64 release_small[AGNOCAST_RELEASE_SMALL];
+	u64 *release_ids;
 	struct agnocast_grants grants = {};
 	struct agnocast_subscriber *sub;
 	struct agnocast_receive arg;
 	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
-	u32 n, i, entry_max, installed = 0;
+	u32 n, i, entry_max, held_after, installed = 0;
 	LIST_HEAD(spare);
 	int ret;
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	if (arg.reserved || !arg.entry_capacity || !arg.pool_capacity)
+	if (!arg.entry_capacity || !arg.pool_capacity || arg.release_count > AGNOCAST_RELEASE_MAX)
 		return -EINVAL;
 	entry_max = min_t(u32, arg.entry_capacity, AGNOCAST_RECEIVE_ENTRIES_MAX);
 	grants.capacity = min_t(u32, arg.pool_capacity, AGNOCAST_RECEIVE_POOLS_MAX);
 	if (agnocast_out_writable(arg.entries, entry_max * sizeof(*entries)) ||
 	    agnocast_out_writable(arg.pools, grants.capacity * sizeof(struct agnocast_pool)) ||
-	    agnocast_arg_writable(&ureceive->reserved, 0))
-		return -EFAULT;
+	    agnocast_arg_writable(&ureceive->release_count, arg.release_count))
+		return agnocast_unwritable(file_ns);
+	ret = agnocast_release_ids_in(arg.release_ids, arg.release_count, release_small,
+				      &release_ids);
+	if (ret)
+		return ret;
 	if (entry_max > ARRAY_SIZE(entries_small)) {
+		ret = -ENOMEM;
 		entries = kvmalloc_array(entry_max, sizeof(*entries), GFP_KERNEL_ACCOUNT);
 		if (!entries)
-			return -ENOMEM;
+			goto out_free_ids;
 	}
 
 relock:
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
 	if (ret)
 		goto out_close;
 	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
 	if (ret)
 		goto out_leave;
 	sub = agnocast_to_subscriber(ep);
+	topic = ep->topic;
+	mutex_lock(&topic->lock);
+	/* Held entries about to be released count as released already. */
+	ret = -ENOENT;
+	if (arg.release_count > sub->nr_held)
+		goto out_unlock;
+	held_after = sub->nr_held - arg.release_count;
 	n = min(entry_max, sub->nr_unreceived);
 	ret = -EDQUOT;
-	if (sub->nr_held >= agnocast_max_held_per_subscriber) {
+	if (held_after >= agnocast_max_held_per_subscriber) {
 		if (n)
-			goto out_leave;
+			goto out_unlock;
 	} else {
-		n = min(n, agnocast_max_held_per_subscriber - sub->nr_held);
+		n = min(n, agnocast_max_held_per_subscriber - held_after);
 	}
 	/* Oldest first; stop at an entry whose pool does not fit in the grants. */
 	for (i = 0; i < n; i++) {
@@ -471,6 +551,7 @@ relock:
 	}
 	n = i;
 	if (grants.count > installed) {
+		mutex_unlock(&topic->lock);
 		agnocast_leave(&ctx);
 		ret = agnocast_grants_install(&grants, installed);
 		if (ret)
@@ -478,9 +559,14 @@ relock:
 		installed = grants.count;
 		goto relock;
 	}
-	ret = agnocast_held_alloc_list(ctx.proc, &spare, n);
+	ret = agnocast_held_alloc_list(&spare, n);
 	if (ret)
-		goto out_leave;
+		goto out_unlock;
+	ret = agnocast_sub_release(sub, release_ids, arg.release_count);
+	if (ret) {
+		agnocast_held_free_list(&spare);
+		goto out_unlock;
+	}
 
 	/* Commit: nothing below fails. */
 	for (i = 0; i < n; i++)
@@ -491,6 +577,7 @@ relock:
 	arg.entry_count = n;
 	arg.pool_count = grants.count;
 	arg.remaining = sub->nr_unreceived;
+	mutex_unlock(&topic->lock);
 	agnocast_leave(&ctx);
 	if (agnocast_answer_out(u64_to_user_ptr(arg.entries), entries, n * sizeof(*entries)) &&
 	    agnocast_answer_out(u64_to_user_ptr(arg.pools), grants.out,
@@ -498,6 +585,8 @@ relock:
 		agnocast_answer_out(uarg, &arg, sizeof(arg));
 	goto out_put;
 
+out_unlock:
+	mutex_unlock(&topic->lock);
 out_leave:
 	agnocast_leave(&ctx);
 out_close:
@@ -506,6 +595,9 @@ out_put:
 	agnocast_grants_put(&grants);
 	if (entries != entries_small)
 		kvfree(entries);
+out_free_ids:
+	if (release_ids != release_small)
+		kvfree(release_ids);
 	return ret;
 }
 
@@ -519,6 +611,7 @@ int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 	struct agnocast_topic_entry *entry;
 	struct agnocast_subscriber *sub;
 	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
 	struct agnocast_take arg;
 	struct agnocast_ctx ctx;
 	u32 attempts = 0;
@@ -527,44 +620,46 @@ int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
 	if (agnocast_arg_writable(&utake->pool_count, arg.pool_count))
-		return -EFAULT;
+		return agnocast_unwritable(file_ns);
 
 relock:
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
 	if (ret)
 		goto out_close;
 	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
 	if (ret)
 		goto out_leave;
 	sub = agnocast_to_subscriber(ep);
+	topic = ep->topic;
 	memset(&arg.entry, 0, sizeof(arg.entry));
 	memset(&arg.pool, 0, sizeof(arg.pool));
 	arg.entry_count = 0;
 	arg.pool_count = 0;
+	mutex_lock(&topic->lock);
 	if (sub->nr_unreceived) {
 		ret = -EDQUOT;
 		if (sub->nr_held >= agnocast_max_held_per_subscriber)
-			goto out_leave;
+			goto out_unlock;
 		entry = agnocast_sub_unreceived(sub, sub->nr_unreceived - 1);
 		if (!agnocast_pool_readable(ctx.proc, &grants, entry->pool)) {
-			/* The newest moved to yet another pool: start over. */
+			/* Install its pool, then look again: the newest may have moved. */
 			ret = -EAGAIN;
-			if (grants.count && ++attempts == AGNOCAST_TAKE_ATTEMPTS)
-				goto out_leave;
+			if (++attempts > AGNOCAST_TAKE_ATTEMPTS)
+				goto out_unlock;
+			agnocast_grants_add_over(&grants, entry->pool);
+			mutex_unlock(&topic->lock);
 			agnocast_leave(&ctx);
-			agnocast_grants_close(&grants);
-			agnocast_grants_put(&grants);
-			grants.count = 0;
-			agnocast_grants_add(&grants, entry->pool);
 			ret = agnocast_grants_install(&grants, 0);
 			if (ret)
-				return ret;
+				goto out_put;
 			goto relock;
 		}
-		ret = agnocast_held_alloc_list(ctx.proc, &spare, 1);
+		ret = agnocast_held_alloc_list(&spare, 1);
 		if (ret)
-			goto out_leave;
+			goto out_unlock;
 		/* Commit: older unreceived entries are passed over, not dropped. */
 		agnocast_entry_out(&arg.entry, entry);
 		arg.entry_count = 1;
@@ -575,10 +670,14 @@ relock:
 		arg.pool = grants.out[0];
 		arg.pool_count = 1;
 	}
+	mutex_unlock(&topic->lock);
 	agnocast_leave(&ctx);
 	agnocast_answer_out(uarg, &arg, sizeof(arg));
+	ret = 0;
 	goto out_put;
 
+out_unlock:
+	mutex_unlock(&topic->lock);
 out_leave:
 	agnocast_leave(&ctx);
 out_close:
@@ -590,30 +689,33 @@ out_put:
 
 int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	struct agnocast_subscriber *sub;
+	u64 ids_small[AGNOCAST_RELEASE_SMALL];
 	struct agnocast_release arg;
 	struct agnocast_endpoint *ep;
-	struct agnocast_held *held;
 	struct agnocast_ctx ctx;
+	u64 *ids;
 	int ret;
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, true);
+	if (arg.flags || !arg.count)
+		return -EINVAL;
+	ret = agnocast_release_ids_in(arg.entry_ids, arg.count, ids_small, &ids);
 	if (ret)
 		return ret;
-	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
 	if (ret)
-		goto out_leave;
-	sub = agnocast_to_subscriber(ep);
-	ret = -ENOENT;
-	held = agnocast_sub_find_held(sub, arg.entry_id);
-	if (held) {
-		agnocast_sub_release(sub, held);
-		ret = 0;
+		goto out_free;
+	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	if (!ret) {
+		mutex_lock(&ep->topic->lock);
+		ret = agnocast_sub_release(agnocast_to_subscriber(ep), ids, arg.count);
+		mutex_unlock(&ep->topic->lock);
 	}
-out_leave:
 	agnocast_leave(&ctx);
+out_free:
+	if (ids != ids_small)
+		kvfree(ids);
 	return ret;
 }
 
@@ -624,15 +726,19 @@ int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg)
 	struct agnocast_ctx ctx;
 	int ret;
 
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
 	if (ret)
 		return ret;
 	list_for_each_entry(pub, &ctx.proc->publishers, proc_node) {
+		mutex_lock(&pub->topic->lock);
 		list_for_each_entry(sub, &pub->topic->subscribers, topic_node)
 			arg.shed += agnocast_sub_shed(agnocast_to_subscriber(sub),
 						      ctx.proc->pool);
+		mutex_unlock(&pub->topic->lock);
 	}
+	spin_lock(&ctx.proc->reclaim_lock);
 	arg.reclaimable = ctx.proc->nr_reclaim;
+	spin_unlock(&ctx.proc->reclaim_lock);
 	agnocast_leave(&ctx);
 	if (copy_to_user(uarg, &arg, sizeof(arg)))
 		return -EFAULT;

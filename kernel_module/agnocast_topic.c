@@ -14,7 +14,9 @@
  * before the endpoint exists.
  *
  * This file calls down into the entry engine only, never into ioctls.
- * Everything here is protected by the namespace lock (agnocast_ns.lock).
+ * Topics and endpoints change with the namespace lock (agnocast_ns.lock) held
+ * for write and are looked up with it held at least for read; what the entry
+ * engine keeps of a topic is under the topic's own lock.
  */
 #include <linux/jhash.h>
 #include <linux/minmax.h>
@@ -180,6 +182,7 @@ struct agnocast_topic *agnocast_topic_get(struct agnocast_ns *ns, const char *na
 	INIT_LIST_HEAD(&topic->subscribers);
 	INIT_LIST_HEAD(&topic->entries);
 	xa_init(&topic->endpoints);
+	mutex_init(&topic->lock);
 	hash_add(ns->topics, &topic->hash_node, agnocast_name_hash(name));
 	ns->nr_topics++;
 	return topic;
@@ -195,7 +198,7 @@ void agnocast_topic_maybe_free(struct agnocast_topic *topic)
 {
 	struct agnocast_ns *ns = topic->ns;
 
-	lockdep_assert_held(&ns->lock);
+	lockdep_assert_held_write(&ns->lock);
 	if (topic->nr_publishers || topic->nr_subscribers || topic->nr_entries)
 		return;
 	idr_remove(&ns->topic_handles, topic->handle);
@@ -203,6 +206,7 @@ void agnocast_topic_maybe_free(struct agnocast_topic *topic)
 	agnocast_id_space_put(ns, topic->ids);
 	ns->nr_topics--;
 	xa_destroy(&topic->endpoints);
+	mutex_destroy(&topic->lock);
 	kvfree(topic->schema);
 	kfree(topic);
 }
@@ -290,7 +294,7 @@ struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
 	struct agnocast_publisher *pub;
 	struct agnocast_endpoint *ep;
 
-	lockdep_assert_held(&topic->ns->lock);
+	lockdep_assert_held_write(&topic->ns->lock);
 	if (publisher) {
 		pub = kzalloc(sizeof(*pub), GFP_KERNEL_ACCOUNT);
 		if (!pub)
@@ -343,7 +347,7 @@ void agnocast_endpoint_commit(struct agnocast_endpoint *ep)
 	struct agnocast_proc *proc = ep->proc;
 	struct agnocast_subscriber *sub;
 
-	lockdep_assert_held(&topic->ns->lock);
+	lockdep_assert_held_write(&topic->ns->lock);
 	topic->ids->next_id++;
 	xa_store(&topic->endpoints, ep->id, ep, GFP_NOWAIT);
 	if (ep->publisher) {
@@ -354,8 +358,11 @@ void agnocast_endpoint_commit(struct agnocast_endpoint *ep)
 		return;
 	}
 	sub = agnocast_to_subscriber(ep);
-	if (ep->flags & AGNOCAST_TRANSIENT_LOCAL)
+	if (ep->flags & AGNOCAST_TRANSIENT_LOCAL) {
+		mutex_lock(&topic->lock);
 		agnocast_sub_fill_transient(sub);
+		mutex_unlock(&topic->lock);
+	}
 	list_add_tail(&ep->topic_node, &topic->subscribers);
 	list_add_tail(&ep->proc_node, &proc->subscribers);
 	topic->nr_subscribers++;
@@ -370,16 +377,20 @@ void agnocast_endpoint_destroy(struct agnocast_endpoint *ep)
 	struct agnocast_topic *topic = ep->topic;
 	struct agnocast_proc *proc = ep->proc;
 
-	lockdep_assert_held(&topic->ns->lock);
+	lockdep_assert_held_write(&topic->ns->lock);
 	xa_erase(&topic->endpoints, ep->id);
 	list_del(&ep->topic_node);
 	list_del(&ep->proc_node);
-	if (ep->publisher) {
+	mutex_lock(&topic->lock);
+	if (ep->publisher)
 		agnocast_publisher_drop_window(agnocast_to_publisher(ep));
+	else
+		agnocast_sub_drop_entries(agnocast_to_subscriber(ep));
+	mutex_unlock(&topic->lock);
+	if (ep->publisher) {
 		topic->nr_publishers--;
 		proc->nr_publishers--;
 	} else {
-		agnocast_sub_drop_entries(agnocast_to_subscriber(ep));
 		topic->nr_subscribers--;
 		if (!(ep->flags & AGNOCAST_POLLING))
 			topic->nr_callback_subscribers--;
@@ -412,7 +423,7 @@ void agnocast_proc_drop_endpoints(struct agnocast_proc *proc)
 	struct agnocast_endpoint *ep, *tmp;
 	struct agnocast_topic *topic;
 
-	lockdep_assert_held(&proc->ns->lock);
+	lockdep_assert_held_write(&proc->ns->lock);
 	list_for_each_entry_safe(ep, tmp, &proc->subscribers, proc_node) {
 		topic = ep->topic;
 		agnocast_endpoint_destroy(ep);

@@ -122,10 +122,14 @@ class Device {
   // The most entries and pool grants one receive() returns; larger spans are not filled further.
   static constexpr std::size_t receive_entries_max = 32;
   static constexpr std::size_t receive_pools_max = 8;
+  // Drops the held entries release_ids first, in the same call (at most
+  // AGNOCAST_RELEASE_MAX; all or none).
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                        std::span<PoolGrant> pools) const;
+                        std::span<PoolGrant> pools,
+                        std::span<const std::uint64_t> release_ids = {}) const;
   TakeResult take(EndpointId subscriber) const;
-  void release(EndpointId subscriber, std::uint64_t entry_id) const;
+  // Drops held entries, all or none (1..AGNOCAST_RELEASE_MAX ids).
+  void release(EndpointId subscriber, std::span<const std::uint64_t> entry_ids) const;
   // Drops entries of this process's pool kept only for slow subscribers beyond
   // the publisher's depth; returns how many. Reclaim afterwards.
   std::uint32_t shed() const;

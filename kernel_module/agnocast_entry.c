@@ -9,8 +9,7 @@
  * reuse; otherwise it is freed and may free its pool.
  *
  * A subscriber keeps its unreceived entries in a ring of its depth (a full
- * ring drops its oldest) and its held ones in receive order, so that the
- * usual release, of the oldest held entry, finds it first.
+ * ring drops its oldest) and its held ones in an xarray by entry id.
  *
  * This file never touches user memory and never calls back into topics or
  * ioctls.  Everything about a topic's entries runs under the topic's lock
@@ -23,21 +22,15 @@
 #include "agnocast_internal.h"
 
 static struct kmem_cache *agnocast_entry_cache;
-static struct kmem_cache *agnocast_held_cache;
 
 int agnocast_entry_init(void)
 {
 	agnocast_entry_cache = KMEM_CACHE(agnocast_topic_entry, SLAB_ACCOUNT);
-	agnocast_held_cache = KMEM_CACHE(agnocast_held, SLAB_ACCOUNT);
-	if (agnocast_entry_cache && agnocast_held_cache)
-		return 0;
-	agnocast_entry_exit();
-	return -ENOMEM;
+	return agnocast_entry_cache ? 0 : -ENOMEM;
 }
 
 void agnocast_entry_exit(void)
 {
-	kmem_cache_destroy(agnocast_held_cache);
 	kmem_cache_destroy(agnocast_entry_cache);
 }
 
@@ -186,104 +179,99 @@ void agnocast_sub_fill_transient(struct agnocast_subscriber *sub)
 /* Drops every unreceived and held reference of @sub. */
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub)
 {
-	struct agnocast_held *held, *tmp;
+	struct agnocast_topic_entry *entry;
+	unsigned long id;
 
 	while (sub->nr_unreceived)
 		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
-	list_for_each_entry_safe(held, tmp, &sub->held, node) {
-		agnocast_entry_unref(held->entry);
-		kmem_cache_free(agnocast_held_cache, held);
-	}
-	INIT_LIST_HEAD(&sub->held);
+	xa_for_each(&sub->held, id, entry)
+		agnocast_entry_unref(entry);
+	xa_destroy(&sub->held);
 	sub->nr_held = 0;
 }
 
-void agnocast_held_free_list(struct list_head *list)
+/*
+ * Reserves the held slots of the @n oldest unreceived entries (RECEIVE) or,
+ * with @newest, of the newest one (TAKE, @n 1), so that holding them cannot
+ * fail.
+ */
+int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n, bool newest)
 {
-	struct agnocast_held *held, *tmp;
+	u32 first = newest ? sub->nr_unreceived - n : 0;
+	u32 i;
+	int ret;
 
-	list_for_each_entry_safe(held, tmp, list, node)
-		kmem_cache_free(agnocast_held_cache, held);
-	INIT_LIST_HEAD(list);
-}
-
-/* Fills @list with @n held records, so that holding cannot fail. */
-int agnocast_held_alloc_list(struct list_head *list, u32 n)
-{
-	struct agnocast_held *held;
-
-	INIT_LIST_HEAD(list);
-	while (n--) {
-		held = kmem_cache_alloc(agnocast_held_cache, GFP_KERNEL_ACCOUNT);
-		if (!held) {
-			agnocast_held_free_list(list);
-			return -ENOMEM;
+	lockdep_assert_held(&sub->ep.topic->lock);
+	for (i = 0; i < n; i++) {
+		ret = xa_reserve(&sub->held, agnocast_sub_unreceived(sub, first + i)->id,
+				 GFP_KERNEL_ACCOUNT);
+		if (ret) {
+			while (i--)
+				xa_release(&sub->held, agnocast_sub_unreceived(sub, first + i)->id);
+			return ret;
 		}
-		list_add(&held->node, list);
 	}
 	return 0;
 }
 
-static void agnocast_sub_hold(struct agnocast_subscriber *sub, struct list_head *spare,
+/* Undoes agnocast_sub_reserve_held(). */
+void agnocast_sub_unreserve_held(struct agnocast_subscriber *sub, u32 n, bool newest)
+{
+	u32 first = newest ? sub->nr_unreceived - n : 0;
+	u32 i;
+
+	for (i = 0; i < n; i++)
+		xa_release(&sub->held, agnocast_sub_unreceived(sub, first + i)->id);
+}
+
+/* Stores into a reserved slot: no allocation, cannot fail. */
+static void agnocast_sub_hold(struct agnocast_subscriber *sub,
 			      struct agnocast_topic_entry *entry)
 {
-	struct agnocast_held *held = list_first_entry(spare, struct agnocast_held, node);
-
-	held->entry = entry;
-	list_move_tail(&held->node, &sub->held);
+	xa_store(&sub->held, entry->id, entry, GFP_NOWAIT);
 	sub->nr_held++;
 	sub->received++;
 }
 
-/* RECEIVE: the oldest unreceived entry becomes held (a record from @spare). */
-void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub, struct list_head *spare)
+/* RECEIVE: the oldest unreceived entry becomes held (its slot reserved). */
+void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub)
 {
-	agnocast_sub_hold(sub, spare, agnocast_sub_pop_oldest(sub));
+	agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
 }
 
 /* TAKE: the newest becomes held; older unreceived entries are passed over. */
-void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct list_head *spare)
+void agnocast_sub_take_newest(struct agnocast_subscriber *sub)
 {
 	while (sub->nr_unreceived > 1)
 		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
-	agnocast_sub_hold_oldest(sub, spare);
-}
-
-static struct agnocast_held *agnocast_sub_find_held(struct agnocast_subscriber *sub, u64 entry_id)
-{
-	struct agnocast_held *held;
-
-	list_for_each_entry(held, &sub->held, node) {
-		if (held->entry->id == entry_id)
-			return held;
-	}
-	return NULL;
+	agnocast_sub_hold_oldest(sub);
 }
 
 /*
  * Drops @sub's references to the @n entries @ids, all or none (-ENOENT when
- * one is not held, or listed twice).  Held entries are in receive order and
- * a subscriber releases mostly its oldest, so each is usually found first.
+ * one is not held, or listed twice).  Held entries are found by id in an
+ * xarray; a mark flags those already listed.
  */
 int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n)
 {
-	struct agnocast_held *held, *tmp;
-	LIST_HEAD(found);
+	struct agnocast_topic_entry *entry;
 	u32 i;
 
 	lockdep_assert_held(&sub->ep.topic->lock);
 	for (i = 0; i < n; i++) {
-		held = agnocast_sub_find_held(sub, ids[i]);
-		if (!held) {
-			list_splice(&found, &sub->held);
-			return -ENOENT;
-		}
-		list_move_tail(&held->node, &found);
+		if (!xa_load(&sub->held, ids[i]) || xa_get_mark(&sub->held, ids[i], XA_MARK_0))
+			break;
+		xa_set_mark(&sub->held, ids[i], XA_MARK_0);
 	}
-	list_for_each_entry_safe(held, tmp, &found, node) {
+	if (i < n) {
+		while (i--)
+			xa_clear_mark(&sub->held, ids[i], XA_MARK_0);
+		return -ENOENT;
+	}
+	for (i = 0; i < n; i++) {
+		entry = xa_erase(&sub->held, ids[i]);
 		sub->nr_held--;
-		agnocast_entry_unref(held->entry);
-		kmem_cache_free(agnocast_held_cache, held);
+		agnocast_entry_unref(entry);
 	}
 	return 0;
 }

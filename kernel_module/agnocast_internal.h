@@ -209,7 +209,7 @@ struct agnocast_subscriber {
 	struct agnocast_topic_entry **unreceived;
 	u32 head;
 	u32 nr_unreceived;
-	struct list_head held;		/* of struct agnocast_held, receive order */
+	struct xarray held;		/* entry id -> struct agnocast_topic_entry */
 	u32 nr_held;
 	u64 received;
 	u64 dropped;
@@ -230,11 +230,6 @@ struct agnocast_topic_entry {
 	u32 publisher_id;
 	/* One while in the window, plus one per subscriber reference. */
 	unsigned int refs;
-};
-
-struct agnocast_held {
-	struct list_head node;
-	struct agnocast_topic_entry *entry;
 };
 
 /* Exit records: allocated with what they describe, queued at death. */
@@ -329,10 +324,10 @@ struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subsc
 						     u32 i);
 void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
-int agnocast_held_alloc_list(struct list_head *list, u32 n);
-void agnocast_held_free_list(struct list_head *list);
-void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub, struct list_head *spare);
-void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct list_head *spare);
+int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n, bool newest);
+void agnocast_sub_unreserve_held(struct agnocast_subscriber *sub, u32 n, bool newest);
+void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub);
+void agnocast_sub_take_newest(struct agnocast_subscriber *sub);
 int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n);
 u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool);
 u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *pending);

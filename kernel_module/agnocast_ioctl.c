@@ -494,7 +494,6 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
 	u32 n, i, entry_max, held_after, installed = 0;
-	LIST_HEAD(spare);
 	int ret;
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
@@ -559,12 +558,12 @@ relock:
 		installed = grants.count;
 		goto relock;
 	}
-	ret = agnocast_held_alloc_list(&spare, n);
+	ret = agnocast_sub_reserve_held(sub, n, false);
 	if (ret)
 		goto out_unlock;
 	ret = agnocast_sub_release(sub, release_ids, arg.release_count);
 	if (ret) {
-		agnocast_held_free_list(&spare);
+		agnocast_sub_unreserve_held(sub, n, false);
 		goto out_unlock;
 	}
 
@@ -573,7 +572,7 @@ relock:
 		agnocast_entry_out(&entries[i], agnocast_sub_unreceived(sub, i));
 	agnocast_grants_commit(ctx.proc, &grants);
 	for (i = 0; i < n; i++)
-		agnocast_sub_hold_oldest(sub, &spare);
+		agnocast_sub_hold_oldest(sub);
 	arg.entry_count = n;
 	arg.pool_count = grants.count;
 	arg.remaining = sub->nr_unreceived;
@@ -615,7 +614,6 @@ int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 	struct agnocast_take arg;
 	struct agnocast_ctx ctx;
 	u32 attempts = 0;
-	LIST_HEAD(spare);
 	int ret;
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
@@ -657,13 +655,13 @@ relock:
 				goto out_put;
 			goto relock;
 		}
-		ret = agnocast_held_alloc_list(&spare, 1);
+		ret = agnocast_sub_reserve_held(sub, 1, true);
 		if (ret)
 			goto out_unlock;
 		/* Commit: older unreceived entries are passed over, not dropped. */
 		agnocast_entry_out(&arg.entry, entry);
 		arg.entry_count = 1;
-		agnocast_sub_take_newest(sub, &spare);
+		agnocast_sub_take_newest(sub);
 	}
 	if (grants.count) {
 		agnocast_grants_commit(ctx.proc, &grants);

@@ -16,9 +16,8 @@
  * records and policy nobody can use any more.  Dead states left behind by a last user from another
  * namespace are collected at the next open.
  *
- * Locking order (outermost first):
- *   agnocast_ns_list_lock -> agnocast_ns.lock -> agnocast_proc_table_lock
- * agnocast_ns.users is incremented only under agnocast_ns_list_lock (or while
+ * The locking order is in agnocast_internal.h; agnocast_ns_list_lock is the
+ * outermost.  agnocast_ns.users is incremented only under agnocast_ns_list_lock (or while
  * already nonzero by the holder of a user) and drops to 0 only under it, so a
  * state seen with users == 0 under agnocast_ns_list_lock has no lock holder
  * and may be read and freed without agnocast_ns.lock.  An ioctl on a file

@@ -306,7 +306,7 @@ struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
 		sub = kzalloc(sizeof(*sub), GFP_KERNEL_ACCOUNT);
 		if (!sub)
 			return NULL;
-		INIT_LIST_HEAD(&sub->held);
+		xa_init(&sub->held);
 		ep = &sub->ep;
 		sub->unreceived = kvmalloc_array(arg->depth, sizeof(*sub->unreceived),
 						 GFP_KERNEL_ACCOUNT);

@@ -2,14 +2,29 @@
 /*
  * agnocast: state shared between the module's files.
  *
- * Locking overview (outermost first; see agnocast_ns.c):
- *   1. agnocast_ns_list_lock  (mutex)    the list of namespace states
- *   1a. agnocast_ns.exit_read_lock (mutex) readers of exit records only
- *   2. agnocast_ns.lock       (mutex)    everything inside one namespace
- *   3. agnocast_proc_table_lock (spinlock) tgid -> process lookup; also taken
- *                                        from the process-exit tracepoint
- * receive_fd() and copy_{to,from}_user() may sleep: they run under 2 at most,
- * never under 3.
+ * Locking, outermost first.  Every field below says which lock protects it.
+ *
+ *   agnocast_ns_list_lock (mutex)       the list of namespace states
+ *   agnocast_ns.exit_read_lock (mutex)  serialises readers of exit records
+ *   agnocast_ns.lock (rw_semaphore)     the namespace's structure.  Taken for
+ *       write (killably) by what changes it: registering and tearing down
+ *       processes, adding and removing endpoints (and so topics), attaching
+ *       and freeing pools, setting the policy.  Taken for read (killably) by
+ *       everything else: the data path (PUBLISH, RECLAIM, RECEIVE, TAKE,
+ *       RELEASE, SHED) and introspection.  Holding it for write excludes
+ *       every other call of the namespace, so nothing below is then needed.
+ *   agnocast_topic.lock (mutex)         one topic's entries, windows,
+ *       subscribers' rings and held entries, and counters: the data path of
+ *       different topics never contends.  Never two at once.
+ *   agnocast_proc.reclaim_lock (spinlock) a process's reclaim list, which
+ *       every topic's data path may add to
+ *   agnocast_ns.exit_lock (spinlock)    the namespace's exit record list
+ *   agnocast_proc_table_lock (raw spinlock) changes to the tgid table,
+ *       also taken from the exit and exec tracepoints; lookups use RCU
+ *
+ * No user copy and no descriptor install happens under agnocast_ns.lock or
+ * below: arguments are copied in before, answers staged and copied out
+ * after, descriptors installed in between with no lock held.
  */
 #ifndef _AGNOCAST_INTERNAL_H
 #define _AGNOCAST_INTERNAL_H
@@ -18,23 +33,26 @@
 #include <linux/idr.h>
 #include <linux/list.h>
 #include <linux/mutex.h>
+#include <linux/rwsem.h>
+#include <linux/spinlock.h>
+#include <linux/pid.h>
+#include <linux/slab.h>
 #include <linux/types.h>
 #include <linux/uidgid.h>
 #include <linux/wait.h>
 #include <linux/workqueue.h>
+#include <linux/xarray.h>
 
 #include "agnocast.h"
 
 /* Unreferenced id spaces kept so that topic_local_ids are not reused soon. */
 #define AGNOCAST_DORMANT_ID_SPACES_MAX 1024
-/* Spare messages and held records a process keeps of each kind. */
-#define AGNOCAST_SPARES_MAX 16
 
 struct ipc_namespace;
+struct file;
 struct pid;
 struct super_block;
 struct vfsmount;
-struct agnocast_exit_record_node;
 struct agnocast_policy_state;
 
 extern unsigned long agnocast_pool_size;
@@ -60,10 +78,12 @@ struct agnocast_ns {
 	struct super_block *mq_sb;
 
 	struct mutex exit_read_lock;	/* serialises readers of exit records */
-	struct mutex lock;
-	/* Everything below is protected by @lock. */
+	struct rw_semaphore lock;
+	/* Everything below is protected by @lock (written under it for write). */
 	unsigned long *slot_map;	/* pool_count bits: slot in use */
 	struct agnocast_mempool **slots;	/* pool_count entries */
+	struct list_head orphan_pools;	/* pools whose owner is gone */
+	bool collect_pools;		/* set under @lock for read: one may be free */
 	struct list_head procs;
 	unsigned int nr_procs;
 	DECLARE_HASHTABLE(topics, 8);
@@ -72,30 +92,34 @@ struct agnocast_ns {
 	DECLARE_HASHTABLE(id_spaces, 8);
 	struct list_head dormant_id_spaces; /* oldest first */
 	unsigned int nr_dormant_id_spaces;
+	spinlock_t exit_lock;
+	/* Protected by @exit_lock. */
 	struct list_head exit_records;	/* oldest first */
 	unsigned int nr_exit_records;	/* read without @lock by poll */
 	u64 exit_records_lost;		/* discarded, not yet reported; ditto */
 	u64 exit_records_seq;
 	wait_queue_head_t exit_wait;
-	struct agnocast_policy_state *policy;	/* NULL: everyone may */
+	struct agnocast_policy_state *policy;	/* NULL: everyone may; ns->lock */
 };
 
 /* A publisher's shared-memory pool, occupying one slot. */
 struct agnocast_mempool {
-	/* All fields protected by the namespace lock. */
+	/* Written under the namespace lock for write but @entries. */
 	unsigned int slot;
 	u64 addr;
 	u64 size;
 	struct file *file;		/* read-only reopening; NULL until attached */
 	struct agnocast_proc *owner;	/* NULL once the owner is gone */
+	struct list_head orphan_node;	/* on ns->orphan_pools once it is */
 	struct pid *owner_pid;
-	unsigned long entries;		/* live entries inside the pool */
+	atomic_long_t entries;		/* live entries inside the pool */
 };
 
 /* A registered process. */
 struct agnocast_proc {
-	struct hlist_node table_node;	/* protected by agnocast_proc_table_lock */
-	bool dying;			/* protected by agnocast_proc_table_lock */
+	struct hlist_node table_node;	/* written under agnocast_proc_table_lock */
+	struct rcu_head rcu;
+	bool dying;			/* written under agnocast_proc_table_lock */
 	pid_t tgid;			/* init-namespace number; the table key */
 	u64 exec_id;
 	kuid_t uid;			/* effective uid at registration */
@@ -105,22 +129,19 @@ struct agnocast_proc {
 	/* Queued when the process dies; NULL after. Protected by ns->lock. */
 	struct agnocast_exit_record_node *exit_record;
 
-	/* Protected by ns->lock. */
+	/* Written under ns->lock for write. */
 	struct list_head ns_node;
 	struct agnocast_mempool *pool;
-	struct list_head publishers;
-	struct list_head subscribers;
+	struct list_head publishers;	/* of agnocast_endpoint.proc_node */
+	struct list_head subscribers;	/* ditto */
 	unsigned int nr_publishers;
 	unsigned int nr_subscribers;
-	unsigned long *given;		/* pool_count bits: live pools handed over */
-	unsigned int nr_given;
+	/* pool_count bits: live pools handed over; atomic bit operations. */
+	unsigned long *given;
+	spinlock_t reclaim_lock;
+	/* Protected by @reclaim_lock. */
 	struct list_head reclaim;	/* freed entries of this process's pool */
 	unsigned int nr_reclaim;
-	/* Freed bookkeeping kept for reuse, so publish and receive rarely allocate. */
-	struct list_head spare_msgs;
-	struct list_head spare_held;
-	unsigned int nr_spare_msgs;
-	unsigned int nr_spare_held;
 };
 
 /* Names equal after mangling share one topic_local_id counter. */
@@ -132,16 +153,20 @@ struct agnocast_id_space {
 	char mangled[AGNOCAST_TOPIC_NAME_MAX];
 };
 
+/* Written under ns->lock for write, but what @lock protects. */
 struct agnocast_topic {
 	struct hlist_node hash_node;
 	struct agnocast_ns *ns;
 	struct agnocast_id_space *ids;
 	u32 handle;
+	struct xarray endpoints;	/* id -> struct agnocast_endpoint */
 	struct list_head publishers;	/* by id */
 	struct list_head subscribers;	/* by id */
 	unsigned int nr_publishers;
 	unsigned int nr_subscribers;
 	unsigned int nr_callback_subscribers;
+	struct mutex lock;
+	/* Protected by @lock, with the windows, rings and held entries. */
 	struct list_head entries;	/* by id */
 	unsigned int nr_entries;
 	u64 next_entry_id;
@@ -153,43 +178,54 @@ struct agnocast_topic {
 	char name[AGNOCAST_TOPIC_NAME_MAX];
 };
 
-struct agnocast_publisher {
-	struct list_head topic_node;
-	struct list_head proc_node;
+/*
+ * What publishers and subscribers share: found by id in topic->endpoints.
+ * The head is written under ns->lock for write; the rest of a publisher and
+ * a subscriber under topic->lock.
+ */
+struct agnocast_endpoint {
+	struct list_head topic_node;	/* on topic->publishers or ->subscribers */
+	struct list_head proc_node;	/* on proc->publishers or ->subscribers */
 	struct agnocast_topic *topic;
 	struct agnocast_proc *proc;
+	bool publisher;
 	u32 id;
 	u32 depth;
 	u32 flags;
+	char node[AGNOCAST_NODE_NAME_MAX];
+};
+
+struct agnocast_publisher {
+	struct agnocast_endpoint ep;
 	struct list_head window;	/* oldest first */
 	u32 window_len;
 	u64 published;
 	u64 published_bytes;
-	char node[AGNOCAST_NODE_NAME_MAX];
 };
 
 struct agnocast_subscriber {
-	struct list_head topic_node;
-	struct list_head proc_node;
-	struct agnocast_topic *topic;
-	struct agnocast_proc *proc;
-	u32 id;
-	u32 depth;
-	u32 flags;
-	/* Ring of depth unreceived entries, oldest at @head. */
-	struct agnocast_msg **unreceived;
+	struct agnocast_endpoint ep;
+	/* Ring of ep.depth unreceived entries, oldest at @head. */
+	struct agnocast_topic_entry **unreceived;
 	u32 head;
 	u32 nr_unreceived;
-	struct list_head held;		/* of struct agnocast_held */
+	struct xarray held;		/* entry id -> struct agnocast_topic_entry */
 	u32 nr_held;
 	u64 received;
 	u64 dropped;
-	/* Callback subscribers: queued when the process dies, NULL after. */
+	/* Callback subscribers: queued when the process dies (ns->lock). */
 	struct agnocast_exit_record_node *exit_record;
-	char node[AGNOCAST_NODE_NAME_MAX];
 };
 
-struct agnocast_msg {
+/* AGNOCAST_IGNORE_LOCAL: the subscriber never gets its own process's entries. */
+static inline bool agnocast_sub_ignores(const struct agnocast_endpoint *sub,
+					const struct agnocast_publisher *pub)
+{
+	return (sub->flags & AGNOCAST_IGNORE_LOCAL) && sub->proc == pub->ep.proc;
+}
+
+/* One published message of a topic; the UAPI's entry.  topic->lock. */
+struct agnocast_topic_entry {
 	/* On topic->entries while live, on the owner's reclaim list after. */
 	struct list_head node;
 	struct list_head window_node;	/* valid while @publisher is set */
@@ -203,9 +239,33 @@ struct agnocast_msg {
 	unsigned int refs;
 };
 
-struct agnocast_held {
+/* Exit records: allocated with what they describe, queued at death. */
+struct agnocast_exit_record_node {
 	struct list_head node;
-	struct agnocast_msg *entry;
+	u32 kind;
+	u32 subscriber_id;
+	u64 seq;			/* order of queueing, from 1 */
+	struct pid *pid;
+	char topic[AGNOCAST_TOPIC_NAME_MAX];
+};
+
+static inline struct agnocast_exit_record_node *agnocast_exit_record_alloc(void)
+{
+	return kzalloc(sizeof(struct agnocast_exit_record_node), GFP_KERNEL_ACCOUNT);
+}
+
+static inline void agnocast_exit_record_free(struct agnocast_exit_record_node *rec)
+{
+	if (!rec)
+		return;
+	put_pid(rec->pid);
+	kfree(rec);
+}
+
+/* An open /dev/agnocast. */
+struct agnocast_file {
+	struct agnocast_ns *ns;		/* the opener's namespace, with a user reference */
+	bool may_read_exit_records;	/* decided at open */
 };
 
 /* The calling process's view, valid between agnocast_enter/agnocast_leave. */
@@ -213,6 +273,7 @@ struct agnocast_ctx {
 	struct agnocast_ns *ns;
 	struct agnocast_proc *proc;	/* NULL if not registered */
 	bool ns_from_file;		/* ns is the open file's: no reference of our own */
+	bool write;			/* ns->lock is held for write */
 };
 
 /* agnocast_ns.c */
@@ -223,25 +284,21 @@ void agnocast_ns_get(struct agnocast_ns *ns);
 void agnocast_ns_put(struct agnocast_ns *ns);
 void agnocast_ns_init(void);
 void agnocast_ns_exit(void);
+void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
+				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic);
+void agnocast_exit_records_wake(struct agnocast_ns *ns);
+bool agnocast_exit_records_waiting(const struct agnocast_ns *ns);
+ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
+				   size_t count, bool nonblock);
 
 /* agnocast_process.c */
-int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered);
+int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered,
+		   bool write);
 void agnocast_leave(struct agnocast_ctx *ctx);
 int agnocast_process_init(void);
 void agnocast_process_exit(void);
 int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_unregister_process(struct agnocast_ns *file_ns);
-
-/* agnocast_exit_records.c */
-struct agnocast_exit_record_node *agnocast_exit_record_alloc(void);
-void agnocast_exit_record_free(struct agnocast_exit_record_node *rec);
-void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
-				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic);
-void agnocast_exit_records_wake(struct agnocast_ns *ns);
-bool agnocast_exit_records_waiting(const struct agnocast_ns *ns);
-void agnocast_exit_records_free(struct agnocast_ns *ns);
-ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
-				   size_t count, bool nonblock);
 
 /* agnocast_policy.c */
 int agnocast_policy_check(const struct agnocast_ns *ns, const char *topic, bool publisher);
@@ -253,18 +310,68 @@ int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg);
 struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
 					    struct agnocast_proc *owner);
 int agnocast_pool_attach(struct agnocast_mempool *pool, int fd);
-void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool);
+void agnocast_pool_orphan(struct agnocast_ns *ns, struct agnocast_mempool *pool);
+void agnocast_pools_collect(struct agnocast_ns *ns);
 bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
 				const struct agnocast_mempool *pool);
-int agnocast_pool_prepare(struct agnocast_mempool *pool, struct agnocast_pool *out);
-void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool *pool,
-			     int fd);
+void agnocast_pool_describe(struct agnocast_mempool *pool, struct agnocast_pool *out);
+void agnocast_pool_mark_given(struct agnocast_proc *proc, const struct agnocast_pool *granted,
+			      struct file *file);
 void agnocast_pool_drop_given(struct agnocast_proc *proc);
 
-/* agnocast_topic.c */
-void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
+/* agnocast_entry.c: the entry engine; no user copies, topic->lock held. */
+int agnocast_entry_init(void);
+void agnocast_entry_exit(void);
+struct agnocast_topic_entry *agnocast_entry_alloc(void);
+void agnocast_entry_free(struct agnocast_topic_entry *entry);
+void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
+			    struct agnocast_mempool *pool, u64 addr, u64 bytes);
+void agnocast_publisher_drop_window(struct agnocast_publisher *pub);
+struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subscriber *sub,
+						     u32 i);
+void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
+void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
+int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n, bool newest);
+void agnocast_sub_unreserve_held(struct agnocast_subscriber *sub, u32 n, bool newest);
+void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub);
+void agnocast_sub_take_newest(struct agnocast_subscriber *sub);
+int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n);
+u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool);
+u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *pending);
+void agnocast_reclaim_return(struct agnocast_proc *proc, const u64 *addrs, u32 n);
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
+
+/* agnocast_topic.c: topics, id spaces, endpoints. */
+bool agnocast_topic_name_valid(const char *name);
+bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg, bool publisher);
+struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
+struct agnocast_topic *agnocast_topic_get(struct agnocast_ns *ns, const char *name);
+void agnocast_topic_maybe_free(struct agnocast_topic *topic);
+int agnocast_topic_type_check(struct agnocast_topic *topic,
+			      const struct agnocast_add_endpoint *arg, void **schema);
+struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
+						   struct agnocast_proc *proc,
+						   const struct agnocast_add_endpoint *arg,
+						   bool publisher);
+void agnocast_endpoint_commit(struct agnocast_endpoint *ep);
+void agnocast_endpoint_abandon(struct agnocast_endpoint *ep);
+void agnocast_endpoint_destroy(struct agnocast_endpoint *ep);
+int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool publisher,
+			     struct agnocast_endpoint **out);
+void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
 void agnocast_id_spaces_free(struct agnocast_ns *ns);
+
+static inline struct agnocast_publisher *agnocast_to_publisher(struct agnocast_endpoint *ep)
+{
+	return container_of(ep, struct agnocast_publisher, ep);
+}
+
+static inline struct agnocast_subscriber *agnocast_to_subscriber(struct agnocast_endpoint *ep)
+{
+	return container_of(ep, struct agnocast_subscriber, ep);
+}
+
+/* agnocast_ioctl.c: endpoint and data-path commands (copy in, call down, copy out). */
 int agnocast_add_publisher(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg);
@@ -275,8 +382,6 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg);
-bool agnocast_topic_name_valid(const char *name);
-struct agnocast_topic *agnocast_topic_find(struct agnocast_ns *ns, const char *name);
 
 /* agnocast_introspect.c */
 int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg);

@@ -7,6 +7,7 @@
  * namespace does.  Each call builds its answer in kernel memory under the
  * namespace lock (agnocast_ns.lock) and copies it out after dropping it.
  */
+#include <linux/bitmap.h>
 #include <linux/cred.h>
 #include <linux/mm.h>
 #include <linux/overflow.h>
@@ -39,7 +40,9 @@ int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		return ret;
 
@@ -90,31 +93,31 @@ static void agnocast_publisher_info_fill(struct agnocast_publisher_info *out,
 					 const struct agnocast_publisher *pub,
 					 struct pid_namespace *pid_ns)
 {
-	memcpy(out->node, pub->node, sizeof(out->node));
-	out->id = pub->id;
-	out->pid = pid_nr_ns(pub->proc->pid, pid_ns);
-	out->depth = pub->depth;
-	out->flags = pub->flags;
+	memcpy(out->node, pub->ep.node, sizeof(out->node));
+	out->id = pub->ep.id;
+	out->pid = pid_nr_ns(pub->ep.proc->pid, pid_ns);
+	out->depth = pub->ep.depth;
+	out->flags = pub->ep.flags;
 	out->published = pub->published;
 	out->published_bytes = pub->published_bytes;
 	out->window = pub->window_len;
-	out->uid = from_kuid_munged(current_user_ns(), pub->proc->uid);
+	out->uid = from_kuid_munged(current_user_ns(), pub->ep.proc->uid);
 }
 
 static void agnocast_subscriber_info_fill(struct agnocast_subscriber_info *out,
 					  const struct agnocast_subscriber *sub,
 					  struct pid_namespace *pid_ns)
 {
-	memcpy(out->node, sub->node, sizeof(out->node));
-	out->id = sub->id;
-	out->pid = pid_nr_ns(sub->proc->pid, pid_ns);
-	out->depth = sub->depth;
-	out->flags = sub->flags;
+	memcpy(out->node, sub->ep.node, sizeof(out->node));
+	out->id = sub->ep.id;
+	out->pid = pid_nr_ns(sub->ep.proc->pid, pid_ns);
+	out->depth = sub->ep.depth;
+	out->flags = sub->ep.flags;
 	out->unreceived = sub->nr_unreceived;
 	out->held = sub->nr_held;
 	out->received = sub->received;
 	out->dropped = sub->dropped;
-	out->uid = from_kuid_munged(current_user_ns(), sub->proc->uid);
+	out->uid = from_kuid_munged(current_user_ns(), sub->ep.proc->uid);
 }
 
 /* Answers of TOPIC_INFO, built under the namespace lock. */
@@ -129,8 +132,7 @@ static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_top
 				     struct agnocast_topic_answer *answer)
 {
 	struct pid_namespace *pid_ns = task_active_pid_ns(current);
-	struct agnocast_subscriber *sub;
-	struct agnocast_publisher *pub;
+	struct agnocast_endpoint *ep;
 	struct agnocast_topic *topic;
 	u32 i;
 
@@ -144,21 +146,25 @@ static int agnocast_topic_info_build(struct agnocast_ns *ns, struct agnocast_top
 	answer->subs = kvcalloc(answer->nsub, sizeof(*answer->subs), GFP_KERNEL_ACCOUNT);
 	if ((answer->npub && !answer->pubs) || (answer->nsub && !answer->subs))
 		return -ENOMEM;
+	/* Counters and rings belong to the data path, under the topic's lock. */
+	mutex_lock(&topic->lock);
 	i = 0;
-	list_for_each_entry(pub, &topic->publishers, topic_node) {
+	list_for_each_entry(ep, &topic->publishers, topic_node) {
 		if (i == answer->npub)
 			break;
-		agnocast_publisher_info_fill(&answer->pubs[i++], pub, pid_ns);
+		agnocast_publisher_info_fill(&answer->pubs[i++], agnocast_to_publisher(ep), pid_ns);
 	}
 	i = 0;
-	list_for_each_entry(sub, &topic->subscribers, topic_node) {
+	list_for_each_entry(ep, &topic->subscribers, topic_node) {
 		if (i == answer->nsub)
 			break;
-		agnocast_subscriber_info_fill(&answer->subs[i++], sub, pid_ns);
+		agnocast_subscriber_info_fill(&answer->subs[i++], agnocast_to_subscriber(ep),
+					      pid_ns);
 	}
 	arg->publisher_total = topic->nr_publishers;
 	arg->subscriber_total = topic->nr_subscribers;
 	arg->entries = topic->nr_entries;
+	mutex_unlock(&topic->lock);
 	memcpy(arg->type_name, topic->type_name, sizeof(arg->type_name));
 	arg->type_hash = topic->type_hash;
 	arg->schema_size = topic->schema_size;
@@ -178,7 +184,7 @@ int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EINVAL;
 	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
 		goto out_free;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		goto out_free;
 	ret = agnocast_topic_info_build(ctx.ns, arg, &answer);
@@ -218,7 +224,9 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		return ret;
 
@@ -235,7 +243,7 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 		info->pid = pid_nr_ns(proc->pid, pid_ns);
 		info->publishers = proc->nr_publishers;
 		info->subscribers = proc->nr_subscribers;
-		info->pools_mapped = proc->nr_given;
+		info->pools_mapped = bitmap_weight(proc->given, agnocast_pool_count);
 		info->pool_addr = proc->pool->addr;
 		info->pool_size = proc->pool->size;
 	}
@@ -270,7 +278,7 @@ int agnocast_topic_schema(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EINVAL;
 	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
 		goto out_free_arg;
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		goto out_free_arg;
 	topic = agnocast_topic_find(ctx.ns, arg->name);

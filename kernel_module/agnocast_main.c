@@ -5,11 +5,15 @@
  * The ioctl handler is a thin switch; each command lives in the file that
  * owns its state and copies its own argument in and out.  Every open file
  * holds a user reference on the opener's namespace state, which read() and
- * poll() use for exit records.
+ * poll() use for exit records, and whether its opener may read them.
  */
+#include <linux/capability.h>
 #include <linux/fs.h>
+#include <linux/ipc_namespace.h>
 #include <linux/miscdevice.h>
 #include <linux/mm.h>
+#include <linux/nsproxy.h>
+#include <linux/slab.h>
 #include <linux/module.h>
 #include <linux/overflow.h>
 #include <linux/poll.h>
@@ -97,7 +101,8 @@ static int agnocast_get_version(void __user *uarg)
 
 static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long arg)
 {
-	struct agnocast_ns *ns = file->private_data;
+	struct agnocast_file *af = file->private_data;
+	struct agnocast_ns *ns = af->ns;
 	void __user *uarg = (void __user *)arg;
 
 	switch (cmd) {
@@ -146,29 +151,47 @@ static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long ar
 
 static int agnocast_dev_open(struct inode *inode, struct file *file)
 {
-	struct agnocast_ns *ns = agnocast_ns_get_current();
+	struct agnocast_file *af;
 
-	if (!ns)
+	af = kzalloc(sizeof(*af), GFP_KERNEL_ACCOUNT);
+	if (!af)
 		return -ENOMEM;
-	file->private_data = ns;
+	af->ns = agnocast_ns_get_current();
+	if (!af->ns) {
+		kfree(af);
+		return -ENOMEM;
+	}
+	/*
+	 * Like a file's permissions, decided by the opener: a descriptor
+	 * passed on or kept across setuid() reads what its opener could.
+	 */
+	af->may_read_exit_records =
+		ns_capable_noaudit(current->nsproxy->ipc_ns->user_ns, CAP_SYS_ADMIN);
+	file->private_data = af;
 	return 0;
 }
 
 static int agnocast_dev_release(struct inode *inode, struct file *file)
 {
-	agnocast_ns_put(file->private_data);
+	struct agnocast_file *af = file->private_data;
+
+	agnocast_ns_put(af->ns);
+	kfree(af);
 	return 0;
 }
 
 static ssize_t agnocast_dev_read(struct file *file, char __user *buf, size_t count, loff_t *ppos)
 {
-	return agnocast_read_exit_records(file->private_data, buf, count,
-					  file->f_flags & O_NONBLOCK);
+	struct agnocast_file *af = file->private_data;
+
+	if (!af->may_read_exit_records)
+		return -EPERM;
+	return agnocast_read_exit_records(af->ns, buf, count, file->f_flags & O_NONBLOCK);
 }
 
 static __poll_t agnocast_dev_poll(struct file *file, poll_table *wait)
 {
-	struct agnocast_ns *ns = file->private_data;
+	struct agnocast_ns *ns = ((struct agnocast_file *)file->private_data)->ns;
 
 	poll_wait(file, &ns->exit_wait, wait);
 	return agnocast_exit_records_waiting(ns) ? EPOLLIN | EPOLLRDNORM : 0;
@@ -181,7 +204,7 @@ static const struct file_operations agnocast_fops = {
 	.read = agnocast_dev_read,
 	.poll = agnocast_dev_poll,
 	.unlocked_ioctl = agnocast_ioctl,
-	.compat_ioctl = compat_ptr_ioctl,
+	/* No compat_ioctl: pools live above 4 GiB, out of a 32-bit process's reach. */
 	.llseek = noop_llseek,
 };
 
@@ -200,18 +223,25 @@ static int __init agnocast_init(void)
 	ret = agnocast_params_valid();
 	if (ret)
 		return ret;
-	ret = agnocast_process_init();
+	ret = agnocast_entry_init();
 	if (ret)
 		return ret;
+	ret = agnocast_process_init();
+	if (ret)
+		goto err_entry_exit;
 	agnocast_ns_init();
 	ret = misc_register(&agnocast_misc);
 	if (ret) {
 		pr_err("agnocast: cannot register /dev/agnocast: %d\n", ret);
 		agnocast_ns_exit();
 		agnocast_process_exit();
-		return ret;
+		goto err_entry_exit;
 	}
 	return 0;
+
+err_entry_exit:
+	agnocast_entry_exit();
+	return ret;
 }
 
 static void __exit agnocast_exit(void)
@@ -219,6 +249,7 @@ static void __exit agnocast_exit(void)
 	misc_deregister(&agnocast_misc);
 	agnocast_process_exit();
 	agnocast_ns_exit();
+	agnocast_entry_exit();
 }
 
 module_init(agnocast_init);

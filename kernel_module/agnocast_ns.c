@@ -3,7 +3,9 @@
  * agnocast: per-IPC-namespace state.
  *
  * Topics, ids, pool slots and exit records belong to the IPC namespace of the
- * calling process, like POSIX message queues.  put_ipc_ns() is not exported,
+ * calling process, like POSIX message queues.  Exit records, the list of
+ * what dead processes left behind (their notification queues) read by the
+ * daemon through read(), live here with the namespace that owns them.  put_ipc_ns() is not exported,
  * so no reference on the namespace is taken.  The state is keyed instead by
  * the superblock of the namespace's internal mqueue mount, on which it holds
  * a mount reference: the superblock then outlives the namespace, so no later
@@ -14,9 +16,8 @@
  * records and policy nobody can use any more.  Dead states left behind by a last user from another
  * namespace are collected at the next open.
  *
- * Locking order (outermost first):
- *   agnocast_ns_list_lock -> agnocast_ns.lock -> agnocast_proc_table_lock
- * agnocast_ns.users is incremented only under agnocast_ns_list_lock (or while
+ * The locking order is in agnocast_internal.h; agnocast_ns_list_lock is the
+ * outermost.  agnocast_ns.users is incremented only under agnocast_ns_list_lock (or while
  * already nonzero by the holder of a user) and drops to 0 only under it, so a
  * state seen with users == 0 under agnocast_ns_list_lock has no lock holder
  * and may be read and freed without agnocast_ns.lock.  An ioctl on a file
@@ -24,13 +25,19 @@
  * until release, which cannot run during the ioctl) instead of taking one.
  */
 #include <linux/bitmap.h>
+#include <linux/capability.h>
 #include <linux/debugfs.h>
 #include <linux/fs.h>
 #include <linux/ipc_namespace.h>
 #include <linux/mount.h>
 #include <linux/nsproxy.h>
+#include <linux/pid.h>
+#include <linux/pid_namespace.h>
 #include <linux/sched.h>
 #include <linux/slab.h>
+#include <linux/string.h>
+#include <linux/uaccess.h>
+#include <linux/wait.h>
 
 #include "agnocast_internal.h"
 
@@ -60,6 +67,175 @@ bool agnocast_ns_dead(const struct agnocast_ns *ns)
 	return !READ_ONCE(ns->mq_sb->s_fs_info);
 }
 
+/*
+ * Exit records.  A record is allocated when the thing it will describe is
+ * created (a process registers, a callback subscriber is added), charged to
+ * the creator's memory cgroup, and only moved to the namespace's list when
+ * the process dies: teardown never allocates, so it cannot lose a record to
+ * an allocation failure.  The list is bounded; past
+ * AGNOCAST_EXIT_RECORDS_MAX the oldest records are discarded and counted,
+ * and the reader is told how many before anything else.  The list is
+ * protected by the namespace lock; readers are serialised by exit_read_lock.
+ */
+
+static void agnocast_exit_record_drop_oldest(struct agnocast_ns *ns)
+{
+	struct agnocast_exit_record_node *oldest;
+
+	oldest = list_first_entry(&ns->exit_records, struct agnocast_exit_record_node, node);
+	list_del(&oldest->node);
+	agnocast_exit_record_free(oldest);
+	WRITE_ONCE(ns->nr_exit_records, ns->nr_exit_records - 1);
+	WRITE_ONCE(ns->exit_records_lost, ns->exit_records_lost + 1);
+}
+
+/* Fills @rec and appends it to the namespace's list, which takes it over. */
+void agnocast_exit_record_queue(struct agnocast_ns *ns, struct agnocast_exit_record_node *rec,
+				u32 kind, struct pid *pid, u32 subscriber_id, const char *topic)
+{
+	rec->kind = kind;
+	rec->subscriber_id = subscriber_id;
+	rec->pid = get_pid(pid);
+	if (topic)
+		strscpy(rec->topic, topic, sizeof(rec->topic));
+	spin_lock(&ns->exit_lock);
+	if (ns->nr_exit_records >= AGNOCAST_EXIT_RECORDS_MAX)
+		agnocast_exit_record_drop_oldest(ns);
+	rec->seq = ++ns->exit_records_seq;
+	list_add_tail(&rec->node, &ns->exit_records);
+	WRITE_ONCE(ns->nr_exit_records, ns->nr_exit_records + 1);
+	spin_unlock(&ns->exit_lock);
+}
+
+void agnocast_exit_records_wake(struct agnocast_ns *ns)
+{
+	wake_up_interruptible(&ns->exit_wait);
+}
+
+bool agnocast_exit_records_waiting(const struct agnocast_ns *ns)
+{
+	return READ_ONCE(ns->nr_exit_records) || READ_ONCE(ns->exit_records_lost);
+}
+
+static void agnocast_exit_records_free(struct agnocast_ns *ns)
+{
+	struct agnocast_exit_record_node *rec, *tmp;
+
+	list_for_each_entry_safe(rec, tmp, &ns->exit_records, node)
+		agnocast_exit_record_free(rec);
+	INIT_LIST_HEAD(&ns->exit_records);
+	ns->nr_exit_records = 0;
+	ns->exit_records_lost = 0;
+}
+
+/* Most records one read() returns: bounds the staging buffer. */
+#define AGNOCAST_EXIT_READ_MAX 64
+
+/*
+ * Snapshots up to @max records (a LOST record first when some were
+ * discarded) into @out; the namespace lock is held.  Returns the count and
+ * the sequence number of the last record taken, for agnocast_exit_forget().
+ */
+static size_t agnocast_exit_snapshot(struct agnocast_ns *ns, struct agnocast_exit_record *out,
+				     size_t max, struct pid_namespace *pid_ns, u64 *lost,
+				     u64 *last_seq)
+{
+	struct agnocast_exit_record_node *rec;
+	size_t n = 0;
+
+	lockdep_assert_held(&ns->exit_lock);
+	memset(out, 0, max * sizeof(*out));
+	*lost = min_t(u64, ns->exit_records_lost, U32_MAX);
+	if (*lost) {
+		out[n].kind = AGNOCAST_EXIT_LOST;
+		out[n].subscriber_id = *lost;
+		n++;
+	}
+	*last_seq = 0;
+	list_for_each_entry(rec, &ns->exit_records, node) {
+		if (n == max)
+			break;
+		out[n].kind = rec->kind;
+		out[n].pid = pid_nr_ns(rec->pid, pid_ns);
+		out[n].subscriber_id = rec->subscriber_id;
+		memcpy(out[n].topic, rec->topic, sizeof(out[n].topic));
+		*last_seq = rec->seq;
+		n++;
+	}
+	return n;
+}
+
+/* Forgets what a read delivered: @lost discards and records up to @last_seq. */
+static void agnocast_exit_forget(struct agnocast_ns *ns, u64 lost, u64 last_seq)
+{
+	struct agnocast_exit_record_node *rec, *tmp;
+
+	lockdep_assert_held(&ns->exit_lock);
+	/* Discards since the snapshot may have taken delivered records: over-report. */
+	WRITE_ONCE(ns->exit_records_lost, ns->exit_records_lost - min(lost, ns->exit_records_lost));
+	list_for_each_entry_safe(rec, tmp, &ns->exit_records, node) {
+		if (rec->seq > last_seq)
+			break;
+		list_del(&rec->node);
+		agnocast_exit_record_free(rec);
+		WRITE_ONCE(ns->nr_exit_records, ns->nr_exit_records - 1);
+	}
+}
+
+/*
+ * Copies whole records to @buf, oldest first.  The user copy happens with
+ * only exit_read_lock held (readers are serialised; writers never wait for
+ * it), and records are forgotten only once copied.
+ */
+ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf, size_t count,
+				   bool nonblock)
+{
+	struct pid_namespace *pid_ns = task_active_pid_ns(current);
+	struct agnocast_exit_record *out;
+	size_t max = min_t(size_t, count / sizeof(*out), AGNOCAST_EXIT_READ_MAX);
+	u64 lost, last_seq;
+	ssize_t ret;
+	size_t n;
+
+	if (!max)
+		return -EINVAL;
+	out = kvmalloc_array(max, sizeof(*out), GFP_KERNEL_ACCOUNT);
+	if (!out)
+		return -ENOMEM;
+	ret = mutex_lock_killable(&ns->exit_read_lock);
+	if (ret)
+		goto out_free;
+
+	for (;;) {
+		spin_lock(&ns->exit_lock);
+		if (agnocast_exit_records_waiting(ns))
+			break;
+		spin_unlock(&ns->exit_lock);
+		ret = -EAGAIN;
+		if (nonblock)
+			goto out_unlock_read;
+		ret = wait_event_interruptible(ns->exit_wait, agnocast_exit_records_waiting(ns));
+		if (ret)
+			goto out_unlock_read;
+	}
+	n = agnocast_exit_snapshot(ns, out, max, pid_ns, &lost, &last_seq);
+	spin_unlock(&ns->exit_lock);
+
+	ret = -EFAULT;
+	if (copy_to_user(buf, out, n * sizeof(*out)))
+		goto out_unlock_read;
+	spin_lock(&ns->exit_lock);
+	agnocast_exit_forget(ns, lost, last_seq);
+	spin_unlock(&ns->exit_lock);
+	ret = n * sizeof(*out);
+
+out_unlock_read:
+	mutex_unlock(&ns->exit_read_lock);
+out_free:
+	kvfree(out);
+	return ret;
+}
+
 static struct agnocast_ns *agnocast_ns_alloc(void)
 {
 	struct agnocast_ns *ns;
@@ -77,7 +253,9 @@ static struct agnocast_ns *agnocast_ns_alloc(void)
 	ns->mq_mnt = mntget(agnocast_current_mq_mnt());
 	ns->mq_sb = ns->mq_mnt->mnt_sb;
 	mutex_init(&ns->exit_read_lock);
-	mutex_init(&ns->lock);
+	init_rwsem(&ns->lock);
+	spin_lock_init(&ns->exit_lock);
+	INIT_LIST_HEAD(&ns->orphan_pools);
 	INIT_LIST_HEAD(&ns->procs);
 	hash_init(ns->topics);
 	idr_init(&ns->topic_handles);
@@ -103,7 +281,6 @@ static void agnocast_ns_free(struct agnocast_ns *ns)
 	idr_destroy(&ns->topic_handles);
 	kvfree(ns->slots);
 	bitmap_free(ns->slot_map);
-	mutex_destroy(&ns->lock);
 	mutex_destroy(&ns->exit_read_lock);
 	mntput(ns->mq_mnt);
 	kfree(ns);

@@ -241,7 +241,7 @@ int agnocast_set_policy(struct agnocast_ns *file_ns, void __user *uarg)
 		return -EINVAL;
 	}
 
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, true);
 	if (ret) {
 		agnocast_policy_free(policy);
 		return ret;
@@ -315,7 +315,7 @@ int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg)
 	rule_capacity = arg.rule_count;
 	principal_capacity = arg.principal_count;
 
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, false);
 	if (ret)
 		return ret;
 	ret = agnocast_policy_copy_out(ctx.ns->policy, &copy);

@@ -19,7 +19,12 @@
  * included).  The kernel keeps only a read-only reopening of it, so whoever
  * receives it can never map the pool writable.
  *
- * All state here is protected by the namespace lock (agnocast_ns.lock).
+ * Slots and pools change under the namespace lock (agnocast_ns.lock) held
+ * for write.  Under it held for read, the data path counts entries in a pool
+ * (atomically) and sets bits of a process's given map (atomic bit
+ * operations).  A pool whose owner is gone and whose last entry goes under
+ * the read lock is freed by the next agnocast_leave(), which takes the lock
+ * for write.
  */
 #include <linux/bitmap.h>
 #include <linux/fcntl.h>
@@ -40,7 +45,7 @@ struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
 	struct agnocast_mempool *pool;
 	unsigned long slot;
 
-	lockdep_assert_held(&ns->lock);
+	lockdep_assert_held_write(&ns->lock);
 	slot = find_first_zero_bit(ns->slot_map, agnocast_pool_count);
 	if (slot >= agnocast_pool_count)
 		return ERR_PTR(-ENOSPC);
@@ -103,23 +108,42 @@ out_put:
 	return ret;
 }
 
-void agnocast_pool_maybe_free(struct agnocast_ns *ns, struct agnocast_mempool *pool)
+static void agnocast_pool_free(struct agnocast_ns *ns, struct agnocast_mempool *pool)
 {
 	struct agnocast_proc *proc;
 
-	lockdep_assert_held(&ns->lock);
-	if (pool->owner || pool->entries)
-		return;
-	list_for_each_entry(proc, &ns->procs, ns_node) {
-		if (__test_and_clear_bit(pool->slot, proc->given))
-			proc->nr_given--;
-	}
+	list_for_each_entry(proc, &ns->procs, ns_node)
+		clear_bit(pool->slot, proc->given);
 	clear_bit(pool->slot, ns->slot_map);
 	ns->slots[pool->slot] = NULL;
 	if (pool->file)
 		fput(pool->file);
 	put_pid(pool->owner_pid);
 	kfree(pool);
+}
+
+/* The owner is gone: the pool lives on while entries in it do. */
+void agnocast_pool_orphan(struct agnocast_ns *ns, struct agnocast_mempool *pool)
+{
+	lockdep_assert_held_write(&ns->lock);
+	pool->owner = NULL;
+	list_add_tail(&pool->orphan_node, &ns->orphan_pools);
+	ns->collect_pools = true;
+}
+
+/* Frees the ownerless pools no entry lives in any more. */
+void agnocast_pools_collect(struct agnocast_ns *ns)
+{
+	struct agnocast_mempool *pool, *tmp;
+
+	lockdep_assert_held_write(&ns->lock);
+	ns->collect_pools = false;
+	list_for_each_entry_safe(pool, tmp, &ns->orphan_pools, orphan_node) {
+		if (atomic_long_read(&pool->entries))
+			continue;
+		list_del(&pool->orphan_node);
+		agnocast_pool_free(ns, pool);
+	}
 }
 
 /* Whether @proc must be given @pool's file to read entries in it. */
@@ -129,42 +153,35 @@ bool agnocast_pool_needs_giving(const struct agnocast_proc *proc,
 	return pool->owner != proc && !test_bit(pool->slot, proc->given);
 }
 
-/*
- * Handing a pool over is two-phase so that a call can fail without leaving a
- * descriptor behind: agnocast_pool_prepare() reserves a descriptor number
- * and describes the pool in @out; then either agnocast_pool_hand_over()
- * installs the read-only file there, or put_unused_fd() gives the number back.
- */
-int agnocast_pool_prepare(struct agnocast_mempool *pool, struct agnocast_pool *out)
+/* Describes @pool for a subscriber; the descriptor comes later. */
+void agnocast_pool_describe(struct agnocast_mempool *pool, struct agnocast_pool *out)
 {
-	int fd;
-
-	if (WARN_ON_ONCE(!pool->file))
-		return -EINVAL;
-	fd = get_unused_fd_flags(O_CLOEXEC);
-	if (fd < 0)
-		return fd;
 	memset(out, 0, sizeof(*out));
 	out->addr = pool->addr;
 	out->size = pool->size;
-	out->fd = fd;
+	out->fd = -1;
 	out->pid = pid_nr_ns(pool->owner_pid, task_active_pid_ns(current));
-	return 0;
 }
 
-void agnocast_pool_hand_over(struct agnocast_proc *proc, struct agnocast_mempool *pool,
-			     int fd)
+/*
+ * @proc now has a descriptor of @file, described by @granted: the pool is
+ * given if it is still the slot's pool (the file reference the caller holds
+ * keeps the file, and so the comparison, unambiguous).
+ */
+void agnocast_pool_mark_given(struct agnocast_proc *proc, const struct agnocast_pool *granted,
+			      struct file *file)
 {
+	unsigned long slot = (granted->addr - agnocast_pool_base) / agnocast_pool_size;
+	struct agnocast_mempool *pool = proc->ns->slots[slot];
+
 	lockdep_assert_held(&proc->ns->lock);
-	fd_install(fd, get_file(pool->file));
-	if (!__test_and_set_bit(pool->slot, proc->given))
-		proc->nr_given++;
+	if (pool && pool->file == file)
+		set_bit(slot, proc->given);
 }
 
 /* Teardown: @proc no longer maps any pool it was given. */
 void agnocast_pool_drop_given(struct agnocast_proc *proc)
 {
-	lockdep_assert_held(&proc->ns->lock);
+	lockdep_assert_held_write(&proc->ns->lock);
 	bitmap_zero(proc->given, agnocast_pool_count);
-	proc->nr_given = 0;
 }

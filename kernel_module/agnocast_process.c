@@ -6,22 +6,21 @@
  * agnocast_proc_table.  Its death is detected with a probe on the
  * sched_process_exit tracepoint rather than with the device file's release:
  * the probe fires for every way a process can die (kill -9 included) and for
- * any number of threads (we act on the last one, signal->live == 0), and
- * since it is keyed by tgid and not by file, a forked child that inherited
- * the descriptor neither keeps the parent's registration alive nor tears it
- * down.  The probe runs in atomic context, so it only marks the process dying
- * and queues its teardown on agnocast_wq; teardown runs under the namespace
- * lock in process context.
+ * any number of threads (we act on the last one), and since it is keyed by
+ * tgid and not by file, a forked child that inherited the descriptor neither
+ * keeps the parent's registration alive nor tears it down.  exec is detected
+ * when it happens, by a probe on sched_process_exec, and handled like an
+ * exit: the new program starts unregistered.
  *
- * exec is detected lazily: the registration records self_exec_id, and a call
- * from the same tgid with another exec id first tears the old registration
- * down as if the process had exited.
+ * The probes only mark the process dying and queue its teardown on
+ * agnocast_wq; teardown runs in process context with the namespace lock held
+ * for write.  They take nothing but the table's raw spinlock (a
+ * PREEMPT_RT spinlock_t would sleep) and queue_work(), which uses raw locks.
  *
- * Locking order (outermost first):
- *   agnocast_ns_list_lock -> agnocast_ns.lock -> agnocast_proc_table_lock
- * The table lock is a raw spinlock because the exit probe runs with
- * preemption disabled, where PREEMPT_RT's spinlock_t, a sleeping lock, must
- * not be taken.
+ * Calls find the caller's record by tgid under RCU, without a lock: records
+ * leave the table under the raw spinlock and are freed after a grace period.
+ * A dying record is invisible, so a call racing with teardown sees the
+ * process unregistered.
  */
 #include <linux/bitmap.h>
 #include <linux/cred.h>
@@ -31,6 +30,7 @@
 #include <linux/nsproxy.h>
 #include <linux/pid.h>
 #include <linux/pid_namespace.h>
+#include <linux/rculist.h>
 #include <linux/sched.h>
 #include <linux/sched/signal.h>
 #include <linux/slab.h>
@@ -43,16 +43,18 @@
 static DEFINE_RAW_SPINLOCK(agnocast_proc_table_lock);
 static DEFINE_HASHTABLE(agnocast_proc_table, 10);
 static struct workqueue_struct *agnocast_wq;
-static struct tracepoint *agnocast_exit_tp;
 
-/* Finds the live registration of @tgid.  Dying ones are being torn down. */
+/*
+ * Finds the live registration of @tgid, under RCU or the table lock.  Dying
+ * ones are being torn down.
+ */
 static struct agnocast_proc *agnocast_proc_lookup(pid_t tgid)
 {
 	struct agnocast_proc *proc;
 
-	lockdep_assert_held(&agnocast_proc_table_lock);
-	hash_for_each_possible(agnocast_proc_table, proc, table_node, tgid) {
-		if (proc->tgid == tgid && !proc->dying)
+	hash_for_each_possible_rcu(agnocast_proc_table, proc, table_node, tgid,
+				   lockdep_is_held(&agnocast_proc_table_lock)) {
+		if (proc->tgid == tgid && !READ_ONCE(proc->dying))
 			return proc;
 	}
 	return NULL;
@@ -62,12 +64,14 @@ static void agnocast_queue_exit_records(struct agnocast_proc *proc)
 {
 	struct agnocast_ns *ns = proc->ns;
 	struct agnocast_subscriber *sub;
+	struct agnocast_endpoint *ep;
 
-	list_for_each_entry(sub, &proc->subscribers, proc_node) {
+	list_for_each_entry(ep, &proc->subscribers, proc_node) {
+		sub = agnocast_to_subscriber(ep);
 		if (!sub->exit_record)
 			continue;
 		agnocast_exit_record_queue(ns, sub->exit_record, AGNOCAST_EXIT_QUEUE, proc->pid,
-					   sub->id, sub->topic->name);
+					   ep->id, ep->topic->name);
 		sub->exit_record = NULL;
 	}
 	agnocast_exit_record_queue(ns, proc->exit_record, AGNOCAST_EXIT_PROCESS, proc->pid, 0,
@@ -78,15 +82,15 @@ static void agnocast_queue_exit_records(struct agnocast_proc *proc)
 
 /*
  * Drops everything @proc holds and frees it.  The caller has set proc->dying
- * and holds the namespace lock.
+ * and holds the namespace lock for write.
  */
 static void agnocast_proc_teardown(struct agnocast_proc *proc, bool record)
 {
 	struct agnocast_ns *ns = proc->ns;
 
-	lockdep_assert_held(&ns->lock);
+	lockdep_assert_held_write(&ns->lock);
 	raw_spin_lock(&agnocast_proc_table_lock);
-	hash_del(&proc->table_node);
+	hash_del_rcu(&proc->table_node);
 	raw_spin_unlock(&agnocast_proc_table_lock);
 
 	if (record)
@@ -94,15 +98,16 @@ static void agnocast_proc_teardown(struct agnocast_proc *proc, bool record)
 	agnocast_proc_drop_endpoints(proc);
 	agnocast_proc_drop_reclaim(proc);
 	agnocast_pool_drop_given(proc);
-	proc->pool->owner = NULL;
-	agnocast_pool_maybe_free(ns, proc->pool);
+	agnocast_pool_orphan(ns, proc->pool);
+	agnocast_pools_collect(ns);
 
 	list_del(&proc->ns_node);
 	ns->nr_procs--;
 	put_pid(proc->pid);
 	agnocast_exit_record_free(proc->exit_record);
 	bitmap_free(proc->given);
-	kfree(proc);
+	/* Lookups under RCU may still see it. */
+	kfree_rcu(proc, rcu);
 	module_put(THIS_MODULE);
 }
 
@@ -114,74 +119,149 @@ static void agnocast_teardown_work(struct work_struct *work)
 
 	/* @proc keeps @ns from being freed until we hold a user reference. */
 	agnocast_ns_get(ns);
-	mutex_lock(&ns->lock);
+	down_write(&ns->lock);
 	agnocast_proc_teardown(proc, true);
-	mutex_unlock(&ns->lock);
+	up_write(&ns->lock);
 	agnocast_ns_put(ns);
 }
 
-/*
- * sched_process_exit probe: atomic context, runs for every exiting thread
- * after it left signal->live; the last thread of a group sees 0.  Two threads
- * exiting together may both see 0, hence the dying flag.
- */
-static void agnocast_on_process_exit(void *data, struct task_struct *p)
+/* Whether a registration of @tgid is dying but not torn down yet. */
+static bool agnocast_proc_pending(pid_t tgid)
+{
+	struct agnocast_proc *proc;
+	bool pending = false;
+
+	rcu_read_lock();
+	hash_for_each_possible_rcu(agnocast_proc_table, proc, table_node, tgid) {
+		if (proc->tgid == tgid && READ_ONCE(proc->dying))
+			pending = true;
+	}
+	rcu_read_unlock();
+	return pending;
+}
+
+/* Marks @tgid's registration dying and queues its teardown. */
+static void agnocast_proc_end(pid_t tgid)
 {
 	struct agnocast_proc *proc;
 
-	if (atomic_read(&p->signal->live))
-		return;
 	raw_spin_lock(&agnocast_proc_table_lock);
-	proc = agnocast_proc_lookup(p->tgid);
+	proc = agnocast_proc_lookup(tgid);
 	if (proc) {
-		proc->dying = true;
+		WRITE_ONCE(proc->dying, true);
 		queue_work(agnocast_wq, &proc->teardown_work);
 	}
 	raw_spin_unlock(&agnocast_proc_table_lock);
 }
 
-static void agnocast_find_exit_tp(struct tracepoint *tp, void *priv)
+/*
+ * sched_process_exit probe: runs for every exiting thread after it left
+ * signal->live; the last thread of a group sees 0.  Two threads exiting
+ * together may both see 0, hence the dying flag.  Newer kernels pass
+ * group_dead, which says the same (AGNOCAST_EXIT_TP_GROUP_DEAD, set by Kbuild
+ * from the tracepoint's prototype in the headers built against).
+ */
+#ifdef AGNOCAST_EXIT_TP_GROUP_DEAD
+static void agnocast_on_process_exit(void *data, struct task_struct *p, bool group_dead)
 {
+	if (group_dead)
+		agnocast_proc_end(p->tgid);
+}
+#else
+static void agnocast_on_process_exit(void *data, struct task_struct *p)
+{
+	if (!atomic_read(&p->signal->live))
+		agnocast_proc_end(p->tgid);
+}
+#endif
+
+/*
+ * sched_process_exec probe: the old program is gone; everything it
+ * registered goes as at exit.  A multi-threaded exec has made the caller
+ * the group leader by now, with the same tgid.
+ */
+static void agnocast_on_process_exec(void *data, struct task_struct *p, pid_t old_pid,
+				     struct linux_binprm *bprm)
+{
+	agnocast_proc_end(p->tgid);
+}
+
+struct agnocast_tracepoints {
+	struct tracepoint *exit;
+	struct tracepoint *exec;
+};
+
+static struct agnocast_tracepoints agnocast_tps;
+
+static void agnocast_find_tps(struct tracepoint *tp, void *priv)
+{
+	struct agnocast_tracepoints *tps = priv;
+
 	if (!strcmp(tp->name, "sched_process_exit"))
-		*(struct tracepoint **)priv = tp;
+		tps->exit = tp;
+	else if (!strcmp(tp->name, "sched_process_exec"))
+		tps->exec = tp;
 }
 
 int agnocast_process_init(void)
 {
 	int ret;
 
-	for_each_kernel_tracepoint(agnocast_find_exit_tp, &agnocast_exit_tp);
-	if (!agnocast_exit_tp) {
-		pr_err("agnocast: tracepoint sched_process_exit not found\n");
+	for_each_kernel_tracepoint(agnocast_find_tps, &agnocast_tps);
+	if (!agnocast_tps.exit || !agnocast_tps.exec) {
+		pr_err("agnocast: tracepoint sched_process_exit or sched_process_exec not found\n");
 		return -ENOENT;
 	}
 	agnocast_wq = alloc_workqueue("agnocast", WQ_UNBOUND, 0);
 	if (!agnocast_wq)
 		return -ENOMEM;
-	ret = tracepoint_probe_register(agnocast_exit_tp, agnocast_on_process_exit, NULL);
+	ret = tracepoint_probe_register(agnocast_tps.exit, agnocast_on_process_exit, NULL);
 	if (ret) {
 		pr_err("agnocast: cannot probe sched_process_exit: %d\n", ret);
-		destroy_workqueue(agnocast_wq);
-		return ret;
+		goto err_destroy_wq;
+	}
+	ret = tracepoint_probe_register(agnocast_tps.exec, agnocast_on_process_exec, NULL);
+	if (ret) {
+		pr_err("agnocast: cannot probe sched_process_exec: %d\n", ret);
+		goto err_unregister_exit;
 	}
 	return 0;
+
+err_unregister_exit:
+	tracepoint_probe_unregister(agnocast_tps.exit, agnocast_on_process_exit, NULL);
+	tracepoint_synchronize_unregister();
+err_destroy_wq:
+	destroy_workqueue(agnocast_wq);
+	return ret;
 }
 
 void agnocast_process_exit(void)
 {
-	tracepoint_probe_unregister(agnocast_exit_tp, agnocast_on_process_exit, NULL);
+	tracepoint_probe_unregister(agnocast_tps.exec, agnocast_on_process_exec, NULL);
+	tracepoint_probe_unregister(agnocast_tps.exit, agnocast_on_process_exit, NULL);
 	tracepoint_synchronize_unregister();
 	/* Waits for teardowns still running (they hold the module until done). */
 	destroy_workqueue(agnocast_wq);
+	/* Records freed with kfree_rcu() must be gone before the module is. */
+	rcu_barrier();
 }
 
-/* Takes the namespace lock and finds the caller's registration. */
-int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered)
+/*
+ * Takes the namespace lock (for write if @write), killably, and finds the
+ * caller's registration.
+ */
+int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered,
+		   bool write)
 {
-	struct agnocast_proc *proc, *stale = NULL;
+	struct agnocast_proc *proc;
 	bool other_ns = false;
+	int ret;
 
 	ctx->proc = NULL;
+	ctx->write = write;
+	/* After exec, the old program's registration is gone before the new one calls. */
+	if (unlikely(agnocast_proc_pending(current->tgid)))
+		flush_workqueue(agnocast_wq);
 	/*
 	 * The open file holds a reference on the state of the namespace it was
 	 * opened in; while the caller is still in that namespace, use it and
@@ -191,22 +271,22 @@ int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool r
 	ctx->ns = ctx->ns_from_file ? file_ns : agnocast_ns_get_current();
 	if (!ctx->ns)
 		return -ENOMEM;
-	mutex_lock(&ctx->ns->lock);
-
-	raw_spin_lock(&agnocast_proc_table_lock);
-	proc = agnocast_proc_lookup(current->tgid);
-	if (proc && proc->ns != ctx->ns) {
-		other_ns = true;
-	} else if (proc && proc->exec_id != current->self_exec_id) {
-		proc->dying = true;
-		stale = proc;
-	} else {
-		ctx->proc = proc;
+	ret = write ? down_write_killable(&ctx->ns->lock) : down_read_killable(&ctx->ns->lock);
+	if (ret) {
+		if (!ctx->ns_from_file)
+			agnocast_ns_put(ctx->ns);
+		return ret;
 	}
-	raw_spin_unlock(&agnocast_proc_table_lock);
 
-	if (stale)
-		agnocast_proc_teardown(stale, true);
+	/* Under the namespace lock, a record of this namespace stays. */
+	rcu_read_lock();
+	proc = agnocast_proc_lookup(current->tgid);
+	if (proc && proc->ns != ctx->ns)
+		other_ns = true;
+	else
+		ctx->proc = proc;
+	rcu_read_unlock();
+
 	if (other_ns || (registered && !ctx->proc)) {
 		agnocast_leave(ctx);
 		return other_ns ? -EXDEV : -ESRCH;
@@ -214,18 +294,31 @@ int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool r
 	return 0;
 }
 
+/* Drops the namespace lock; frees pools the call left ownerless and empty. */
 void agnocast_leave(struct agnocast_ctx *ctx)
 {
-	mutex_unlock(&ctx->ns->lock);
-	if (!ctx->ns_from_file)
-		agnocast_ns_put(ctx->ns);
-}
+	struct agnocast_ns *ns = ctx->ns;
 
+	if (ctx->write) {
+		if (ns->collect_pools)
+			agnocast_pools_collect(ns);
+		up_write(&ns->lock);
+	} else {
+		up_read(&ns->lock);
+		if (READ_ONCE(ns->collect_pools)) {
+			down_write(&ns->lock);
+			agnocast_pools_collect(ns);
+			up_write(&ns->lock);
+		}
+	}
+	if (!ctx->ns_from_file)
+		agnocast_ns_put(ns);
+}
 static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *err)
 {
 	struct agnocast_proc *proc;
 
-	lockdep_assert_held(&ns->lock);
+	lockdep_assert_held_write(&ns->lock);
 	*err = -ENOMEM;
 	proc = kzalloc(sizeof(*proc), GFP_KERNEL_ACCOUNT);
 	if (!proc)
@@ -246,28 +339,26 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 		goto err_free_pool;
 	}
 	proc->tgid = current->tgid;
-	proc->exec_id = current->self_exec_id;
 	proc->uid = current_euid();
 	proc->pid = get_task_pid(current, PIDTYPE_TGID);
 	proc->ns = ns;
 	INIT_WORK(&proc->teardown_work, agnocast_teardown_work);
 	INIT_LIST_HEAD(&proc->publishers);
 	INIT_LIST_HEAD(&proc->subscribers);
+	spin_lock_init(&proc->reclaim_lock);
 	INIT_LIST_HEAD(&proc->reclaim);
-	INIT_LIST_HEAD(&proc->spare_msgs);
-	INIT_LIST_HEAD(&proc->spare_held);
 	list_add_tail(&proc->ns_node, &ns->procs);
 	ns->nr_procs++;
 
 	raw_spin_lock(&agnocast_proc_table_lock);
-	hash_add(agnocast_proc_table, &proc->table_node, proc->tgid);
+	hash_add_rcu(agnocast_proc_table, &proc->table_node, proc->tgid);
 	raw_spin_unlock(&agnocast_proc_table_lock);
 	*err = 0;
 	return proc;
 
 err_free_pool:
-	proc->pool->owner = NULL;
-	agnocast_pool_maybe_free(ns, proc->pool);
+	agnocast_pool_orphan(ns, proc->pool);
+	agnocast_pools_collect(ns);
 err_free_given:
 	agnocast_exit_record_free(proc->exit_record);
 	bitmap_free(proc->given);
@@ -284,10 +375,12 @@ int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg)
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
 	if (arg.pool_fd < -1)
 		return -EBADF;
 
-	ret = agnocast_enter(&ctx, file_ns, false);
+	ret = agnocast_enter(&ctx, file_ns, false, true);
 	if (ret)
 		return ret;
 	if (arg.pool_fd == -1) {
@@ -316,11 +409,11 @@ int agnocast_unregister_process(struct agnocast_ns *file_ns)
 	struct agnocast_ctx ctx;
 	int ret;
 
-	ret = agnocast_enter(&ctx, file_ns, true);
+	ret = agnocast_enter(&ctx, file_ns, true, true);
 	if (ret)
 		return ret;
 	raw_spin_lock(&agnocast_proc_table_lock);
-	ctx.proc->dying = true;
+	WRITE_ONCE(ctx.proc->dying, true);
 	raw_spin_unlock(&agnocast_proc_table_lock);
 	agnocast_proc_teardown(ctx.proc, false);
 	agnocast_leave(&ctx);

@@ -91,7 +91,7 @@ TEST_F(Caps, HeldEntriesPerSubscriber) {
   EXPECT_EQ(more.entries.size(), 1u);
 
   // TAKE as well.
-  auto take = poisoned<agnocast_take>();
+  auto take = poisoned_request<agnocast_take>();
   for (int i = 0; i < 3; i++) {
     take.topic_handle = poll.handle;
     take.subscriber_id = poll.id;

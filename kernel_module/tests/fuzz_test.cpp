@@ -166,6 +166,12 @@ struct Worker {
     arg.pools = chance(90) ? uptr(pools) : uptr(bad_pointer());
     arg.entry_capacity = static_cast<uint32_t>(rnd(17));
     arg.pool_capacity = static_cast<uint32_t>(rnd(5));
+    // Releases batched into the receive: held ids, unknown ones, a bad list.
+    uint64_t release_ids[2];
+    arg.release_count = static_cast<uint32_t>(rnd(3));
+    for (uint32_t i = 0; i < arg.release_count; i++)
+      release_ids[i] = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
+    arg.release_ids = chance(95) ? uptr(release_ids) : uptr(bad_pointer());
     if (ioc(dev, AGNOCAST_IOC_RECEIVE, &arg)) return;
     for (uint32_t i = 0; i < arg.entry_count; i++) entries.push_back(ents[i].entry_id);
     close_pools(pools, arg.pool_count);
@@ -183,15 +189,18 @@ struct Worker {
 
   void do_release() {
     Endpoint e = some_endpoint(subs);
-    uint64_t id = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
-    agnocast_release arg{e.handle, e.id, id};
+    uint64_t ids[3];
+    uint32_t count = 1 + static_cast<uint32_t>(rnd(3));
+    for (uint32_t i = 0; i < count; i++)
+      ids[i] = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
+    agnocast_release arg{e.handle, e.id, chance(95) ? uptr(ids) : uptr(bad_pointer()), count, 0};
     ioctl(dev, AGNOCAST_IOC_RELEASE, &arg);
   }
 
   void introspect() {
     switch (rnd(4)) {
       case 0: {
-        agnocast_list_topics arg{some_ptr(4096), some_u32(16), 0};
+        agnocast_list_topics arg{some_ptr(4096), some_u32(16), 0, 0, 0};
         ioctl(dev, AGNOCAST_IOC_LIST_TOPICS, &arg);
         break;
       }
@@ -206,7 +215,7 @@ struct Worker {
         break;
       }
       case 2: {
-        agnocast_list_processes arg{some_ptr(4096), some_u32(100), 0};
+        agnocast_list_processes arg{some_ptr(4096), some_u32(100), 0, 0, 0};
         ioctl(dev, AGNOCAST_IOC_LIST_PROCESSES, &arg);
         break;
       }
@@ -351,7 +360,7 @@ int main(int argc, char** argv) {
   // Every worker is gone: so must be every registration and every topic.
   int dev = open_device();
   bool clean = eventually([&] {
-    agnocast_list_topics lt{0, 0, 0};
+    agnocast_list_topics lt{0, 0, 0, 0, 0};
     return list_processes(dev).empty() && ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt) == 0 &&
            lt.total == 0;
   });

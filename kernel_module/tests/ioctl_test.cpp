@@ -14,24 +14,24 @@ namespace {
 
 // The ABI: sizes are pinned so that no field moves unnoticed.
 static_assert(sizeof(agnocast_version) == 16);
-static_assert(sizeof(agnocast_register_process) == 24);
+static_assert(sizeof(agnocast_register_process) == 32);
 static_assert(sizeof(agnocast_add_endpoint) == 552);
 static_assert(sizeof(agnocast_remove_endpoint) == 8);
 static_assert(sizeof(agnocast_publish) == 72);
 static_assert(sizeof(agnocast_reclaim) == 24);
 static_assert(sizeof(agnocast_entry) == 24);
 static_assert(sizeof(agnocast_pool) == 24);
-static_assert(sizeof(agnocast_receive) == 48);
-static_assert(sizeof(agnocast_take) == 64);
-static_assert(sizeof(agnocast_release) == 16);
+static_assert(sizeof(agnocast_receive) == 56);
+static_assert(sizeof(agnocast_take) == 72);
+static_assert(sizeof(agnocast_release) == 24);
 static_assert(sizeof(agnocast_topic_summary) == 400);
-static_assert(sizeof(agnocast_list_topics) == 16);
+static_assert(sizeof(agnocast_list_topics) == 24);
 static_assert(sizeof(agnocast_publisher_info) == 168);
 static_assert(sizeof(agnocast_subscriber_info) == 176);
 static_assert(sizeof(agnocast_topic_info) == 432);
 static_assert(sizeof(agnocast_topic_schema) == 272);
 static_assert(sizeof(agnocast_process_info) == 32);
-static_assert(sizeof(agnocast_list_processes) == 16);
+static_assert(sizeof(agnocast_list_processes) == 24);
 static_assert(sizeof(agnocast_exit_record) == 272);
 static_assert(sizeof(agnocast_shed) == 8);
 static_assert(sizeof(agnocast_principal) == 8);
@@ -81,7 +81,7 @@ TEST_F(Device, UnknownCommandIsEnotty) {
 }
 
 TEST_F(Device, RegisterReservesSlotAndRepeats) {
-  auto r = poisoned<agnocast_register_process>();
+  auto r = poisoned_request<agnocast_register_process>();
   r.pool_fd = -1;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);
   EXPECT_EQ(r.pool_fd, -1);
@@ -89,7 +89,7 @@ TEST_F(Device, RegisterReservesSlotAndRepeats) {
   EXPECT_GE(r.pool_addr, 0x40000000000ull);
   EXPECT_EQ(r.pool_addr % 4096, 0u);
   EXPECT_GT(r.pool_size, 0u);
-  auto again = poisoned<agnocast_register_process>();
+  auto again = poisoned_request<agnocast_register_process>();
   again.pool_fd = -1;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &again), 0);
   EXPECT_EQ(again.pool_addr, r.pool_addr);
@@ -98,7 +98,7 @@ TEST_F(Device, RegisterReservesSlotAndRepeats) {
 }
 
 TEST_F(Device, RegisterErrors) {
-  auto r = poisoned<agnocast_register_process>();
+  auto r = poisoned_request<agnocast_register_process>();
   EXPECT_EQ(
       ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, static_cast<agnocast_register_process*>(kBadPtr)),
       -EFAULT);
@@ -109,7 +109,7 @@ TEST_F(Device, RegisterErrors) {
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBADF);
 
   ASSERT_EQ(reg.reserve(dev), 0);
-  r = poisoned<agnocast_register_process>();
+  r = poisoned_request<agnocast_register_process>();
   r.pool_fd = 4000;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBADF);
 
@@ -167,7 +167,7 @@ TEST_F(Device, RegisterErrors) {
   Registration other;
   EXPECT_EQ(in_child([&] {
               if (other.reserve(open_device())) return 10;
-              agnocast_register_process attach = poisoned<agnocast_register_process>();
+              agnocast_register_process attach = poisoned_request<agnocast_register_process>();
               attach.pool_fd = write_sealed;
               return ioc(other.dev, AGNOCAST_IOC_REGISTER_PROCESS, &attach) == 0 ? 0 : 11;
             }),
@@ -175,11 +175,11 @@ TEST_F(Device, RegisterErrors) {
   close(write_sealed);
 
   ASSERT_EQ(reg.attach(), 0);
-  r = poisoned<agnocast_register_process>();
+  r = poisoned_request<agnocast_register_process>();
   r.pool_fd = reg.memfd;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBUSY);
   // Step one after attaching still reports the slot.
-  r = poisoned<agnocast_register_process>();
+  r = poisoned_request<agnocast_register_process>();
   r.pool_fd = -1;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);
   EXPECT_EQ(r.pool_addr, reg.addr);
@@ -210,7 +210,7 @@ TEST_F(Device, EndpointCommandsNeedRegistration) {
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECLAIM, &rc), -ESRCH);
   ReceiveResult rr;
   EXPECT_EQ(receive(dev, {1, 0}, &rr), -ESRCH);
-  auto take = poisoned<agnocast_take>();
+  auto take = poisoned_request<agnocast_take>();
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -ESRCH);
   EXPECT_EQ(release(dev, {1, 0}, 0), -ESRCH);
 }
@@ -308,7 +308,7 @@ TEST_F(Device, TopicTypeIsFixedByItsFirstEndpoint) {
   EXPECT_EQ(info.type_hash, 0x1111u);
   EXPECT_EQ(info.schema_size, schema.size());
   agnocast_topic_summary topics[4];
-  agnocast_list_topics lt{uptr(topics), 4, 0};
+  agnocast_list_topics lt{uptr(topics), 4, 0, 0, 0};
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
   ASSERT_EQ(lt.total, 1u);
   EXPECT_STREQ(topics[0].type_name, "pkg/msg/A");
@@ -780,7 +780,7 @@ TEST_F(Device, ReceiveErrors) {
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, static_cast<agnocast_receive*>(kBadPtr)), -EFAULT);
 
   ASSERT_EQ(publish(dev, pub, reg.addr), 0);
-  arg.reserved = 0;
+  arg.release_count = 0;
   arg.entries = uptr(kBadPtr);
   arg.pools = uptr(kBadPtr);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, &arg), -EFAULT);
@@ -797,7 +797,7 @@ TEST_F(Device, TakeNewestPassesOverOlder) {
   ASSERT_EQ(add_publisher(dev, "/tk", 1, &pub), 0);
   ASSERT_EQ(add_subscriber(dev, "/tk", 3, &sub, AGNOCAST_POLLING), 0);
 
-  auto take = poisoned<agnocast_take>();
+  auto take = poisoned_request<agnocast_take>();
   take.topic_handle = sub.handle;
   take.subscriber_id = sub.id;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), 0);
@@ -809,7 +809,7 @@ TEST_F(Device, TakeNewestPassesOverOlder) {
 
   PublishResult res;
   for (int i = 0; i < 3; i++) ASSERT_EQ(publish(dev, pub, reg.addr + 8 * i, &res), 0);
-  take = poisoned<agnocast_take>();
+  take = poisoned_request<agnocast_take>();
   take.topic_handle = sub.handle;
   take.subscriber_id = sub.id;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), 0);
@@ -871,7 +871,7 @@ TEST_F(Device, Introspection) {
 
   agnocast_topic_summary topics[4];
   std::memset(topics, kPoison, sizeof(topics));
-  auto lt = poisoned<agnocast_list_topics>();
+  auto lt = poisoned_request<agnocast_list_topics>();
   lt.topics = uptr(topics);
   lt.capacity = 4;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
@@ -915,7 +915,7 @@ TEST_F(Device, Introspection) {
 
   std::vector<agnocast_process_info> procs(8);
   std::memset(procs.data(), kPoison, procs.size() * sizeof(procs[0]));
-  auto lp = poisoned<agnocast_list_processes>();
+  auto lp = poisoned_request<agnocast_list_processes>();
   lp.processes = uptr(procs.data());
   lp.capacity = 8;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &lp), 0);
@@ -935,7 +935,7 @@ TEST_F(Device, Introspection) {
   // Introspection needs no registration.
   EXPECT_EQ(in_child([&] {
               int d = open_device();
-              agnocast_list_topics l{0, 0, 0};
+              agnocast_list_topics l{0, 0, 0, 0, 0};
               return ioc(d, AGNOCAST_IOC_LIST_TOPICS, &l) == 0 && l.total == 2 ? 0 : 1;
             }),
             0);
@@ -970,11 +970,16 @@ TEST_F(Device, ExitRecordsReadErrors) {
   EXPECT_EQ(rec[0].topic[0], '\0');
   EXPECT_EQ(static_cast<uint8_t>(rec[1].topic[0]), kPoison);
 
-  // Without CAP_SYS_ADMIN: -EPERM.
+  // Without CAP_SYS_ADMIN at open: -EPERM.  The capability is the opener's:
+  // a descriptor opened with it reads after setuid(), like a file's mode.
   EXPECT_EQ(in_child([&] {
-              if (setuid(65534)) return 10;
+              gid_t group = kAgnocastGroup;
+              if (setgroups(1, &group) || setuid(65534)) return 10;
+              int own = open_device(O_RDONLY | O_NONBLOCK);
+              if (own < 0) return 11;
               agnocast_exit_record r;
-              return read(fd, &r, sizeof(r)) == -1 && errno == EPERM ? 0 : 11;
+              if (read(own, &r, sizeof(r)) != -1 || errno != EPERM) return 12;
+              return read(fd, &r, sizeof(r)) == -1 && errno == EAGAIN ? 0 : 13;
             }),
             0);
   close(fd);
@@ -1102,3 +1107,212 @@ TEST_F(Device, MovedToAnotherIpcNamespaceIsExdev) {
 }
 
 }  // namespace
+
+// The subscriber's unreceived and held counts as TOPIC_INFO reports them.
+static std::pair<uint32_t, uint32_t> unreceived_held(int dev, const char* topic) {
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  if (topic_info(dev, topic, &info, nullptr, &subs) || subs.empty()) return {~0u, ~0u};
+  return {subs[0].unreceived, subs[0].held};
+}
+
+TEST_F(Device, ReleaseTakesAListAllOrNothing) {
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/rl", 8, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/rl", 8, &sub), 0);
+  for (int i = 0; i < 4; i++) ASSERT_EQ(publish(dev, pub, reg.addr + 64 * i), 0);
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, sub, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 4u);
+  EXPECT_EQ(unreceived_held(dev, "/rl"), std::make_pair(0u, 4u));
+
+  // One id not held, or one listed twice: nothing is released.
+  EXPECT_EQ(release_list(dev, sub, {0, 1, 99}), -ENOENT);
+  EXPECT_EQ(release_list(dev, sub, {2, 2}), -ENOENT);
+  EXPECT_EQ(unreceived_held(dev, "/rl"), std::make_pair(0u, 4u));
+  EXPECT_EQ(release_list(dev, sub, {}), -EINVAL);
+  std::vector<uint64_t> too_many(AGNOCAST_RELEASE_MAX + 1, 0);
+  EXPECT_EQ(release_list(dev, sub, too_many), -EINVAL);
+  uint64_t id = 0;
+  agnocast_release bad_list{sub.handle, sub.id, uptr(kBadPtr), 1, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RELEASE, &bad_list), -EFAULT);
+  agnocast_release flagged{sub.handle, sub.id, uptr(&id), 1, 1};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RELEASE, &flagged), -EINVAL);
+  EXPECT_EQ(unreceived_held(dev, "/rl"), std::make_pair(0u, 4u));
+
+  // Out of receive order, all at once.
+  EXPECT_EQ(release_list(dev, sub, {3, 0, 2}), 0);
+  EXPECT_EQ(unreceived_held(dev, "/rl"), std::make_pair(0u, 1u));
+  EXPECT_EQ(release(dev, sub, 0), -ENOENT);
+  EXPECT_EQ(release(dev, sub, 1), 0);
+  EXPECT_EQ(unreceived_held(dev, "/rl"), std::make_pair(0u, 0u));
+}
+
+// RECEIVE with the ids to release: a subscriber's steady state needs no RELEASE.
+static int receive_releasing(int dev, Endpoint sub, const std::vector<uint64_t>& release_ids,
+                             std::vector<agnocast_entry>* got, uint64_t release_ptr = 0) {
+  std::vector<agnocast_entry> entries(8);
+  std::vector<agnocast_pool> pools(4);
+  agnocast_receive arg{};
+  arg.topic_handle = sub.handle;
+  arg.subscriber_id = sub.id;
+  arg.entries = uptr(entries.data());
+  arg.pools = uptr(pools.data());
+  arg.entry_capacity = 8;
+  arg.pool_capacity = 4;
+  arg.release_ids = release_ptr ? release_ptr : uptr(release_ids.data());
+  arg.release_count = static_cast<uint32_t>(release_ids.size());
+  int ret = ioc(dev, AGNOCAST_IOC_RECEIVE, &arg);
+  if (!ret && got) got->assign(entries.begin(), entries.begin() + arg.entry_count);
+  return ret;
+}
+
+TEST_F(Device, ReceiveReleasesTheListedEntriesFirst) {
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/rr", 8, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/rr", 8, &sub), 0);
+  std::vector<agnocast_entry> got;
+  ASSERT_EQ(publish(dev, pub, reg.addr), 0);
+  ASSERT_EQ(receive_releasing(dev, sub, {}, &got), 0);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].entry_id, 0u);
+
+  // Steady state: each receive drops what the previous one delivered.
+  for (uint64_t i = 1; i < 5; i++) {
+    ASSERT_EQ(publish(dev, pub, reg.addr + 64 * i), 0);
+    ASSERT_EQ(receive_releasing(dev, sub, {i - 1}, &got), 0);
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_EQ(got[0].entry_id, i);
+    EXPECT_EQ(unreceived_held(dev, "/rr"), std::make_pair(0u, 1u));
+  }
+  // Nothing to receive: the release still happens.
+  ASSERT_EQ(receive_releasing(dev, sub, {4}, &got), 0);
+  EXPECT_TRUE(got.empty());
+  EXPECT_EQ(unreceived_held(dev, "/rr"), std::make_pair(0u, 0u));
+
+  // A listed id not held: nothing released, nothing received.
+  ASSERT_EQ(publish(dev, pub, reg.addr), 0);
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64), 0);
+  ASSERT_EQ(receive_releasing(dev, sub, {}, &got), 0);
+  ASSERT_EQ(got.size(), 2u);
+  ASSERT_EQ(publish(dev, pub, reg.addr + 128), 0);
+  EXPECT_EQ(receive_releasing(dev, sub, {got[0].entry_id, 1234}, nullptr), -ENOENT);
+  EXPECT_EQ(unreceived_held(dev, "/rr"), std::make_pair(1u, 2u));
+  EXPECT_EQ(receive_releasing(dev, sub, {got[0].entry_id}, nullptr, uptr(kBadPtr)), -EFAULT);
+  EXPECT_EQ(unreceived_held(dev, "/rr"), std::make_pair(1u, 2u));
+  std::vector<uint64_t> too_many(AGNOCAST_RELEASE_MAX + 1, 0);
+  EXPECT_EQ(receive_releasing(dev, sub, too_many, nullptr), -EINVAL);
+  EXPECT_EQ(receive_releasing(dev, sub, {got[0].entry_id, got[1].entry_id}, &got), 0);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(unreceived_held(dev, "/rr"), std::make_pair(0u, 1u));
+}
+
+TEST_F(Device, RequestFlagsAndReservedMustBeZero) {
+  auto r = poisoned_request<agnocast_register_process>();
+  r.pool_fd = -1;
+  r.flags = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  r.flags = 0;
+  r.reserved = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  EXPECT_FALSE(process_listed(dev, getpid()));
+
+  registered();
+  Endpoint sub;
+  ASSERT_EQ(add_subscriber(dev, "/fl", 1, &sub, AGNOCAST_POLLING), 0);
+  auto take = poisoned_request<agnocast_take>();
+  take.topic_handle = sub.handle;
+  take.subscriber_id = sub.id;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), 0);
+  take.flags = 1u << 31;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -EINVAL);
+  take.flags = 0;
+  take.reserved = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -EINVAL);
+
+  agnocast_list_topics lt{0, 0, 0, 1, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), -EINVAL);
+  lt = {0, 0, 0, 0, 1};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), -EINVAL);
+  lt = {0, 0, 0, 0, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt), 0);
+  EXPECT_EQ(lt.total, 1u);
+  agnocast_list_processes lp{0, 0, 0, 2, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &lp), -EINVAL);
+  lp = {0, 0, 0, 0, 2};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &lp), -EINVAL);
+  lp = {0, 0, 0, 0, 0};
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &lp), 0);
+  EXPECT_GE(lp.total, 1u);
+}
+
+// PUBLISH is all or nothing: every output is checked before the entry is
+// published, so -EFAULT means nothing happened.
+TEST_F(Device, PublishWithABadOutputPublishesNothing) {
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/aon", 1, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/aon", 4, &sub), 0);
+  // Two publishes: the first leaves the depth-1 window, reclaimable once received.
+  PublishResult res;
+  ASSERT_EQ(publish(dev, pub, reg.addr, &res), 0);
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64, &res), 0);
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, sub, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 2u);
+  ASSERT_EQ(release(dev, sub, rr.entries[0].entry_id), 0);  // now reclaimable
+
+  auto attempt = [&](auto change) {
+    uint32_t wake[4];
+    uint64_t reclaim[4];
+    agnocast_publish arg{};
+    arg.topic_handle = pub.handle;
+    arg.publisher_id = pub.id;
+    arg.addr = reg.addr + 128;
+    arg.wake_ids = uptr(wake);
+    arg.wake_capacity = 4;
+    arg.reclaim = uptr(reclaim);
+    arg.reclaim_capacity = 4;
+    change(arg);
+    return ioc(dev, AGNOCAST_IOC_PUBLISH, &arg);
+  };
+  auto unchanged = [&] {
+    agnocast_topic_info info;
+    std::vector<agnocast_publisher_info> pubs;
+    std::vector<agnocast_subscriber_info> subs;
+    if (topic_info(dev, "/aon", &info, &pubs, &subs)) return false;
+    return info.entries == 1 && pubs[0].published == 2 && subs[0].unreceived == 0 &&
+           subs[0].held == 1;
+  };
+  EXPECT_EQ(attempt([](agnocast_publish& a) { a.reclaim = uptr(kBadPtr); }), -EFAULT);
+  EXPECT_TRUE(unchanged());
+  EXPECT_EQ(attempt([](agnocast_publish& a) { a.wake_ids = uptr(kBadPtr); }), -EFAULT);
+  EXPECT_TRUE(unchanged());
+
+  // An argument the kernel can read but not write back: nothing published.
+  long page = sysconf(_SC_PAGESIZE);
+  void* ro = mmap(nullptr, page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(ro, MAP_FAILED);
+  uint32_t wake[4];
+  uint64_t reclaim[4];
+  auto* arg = static_cast<agnocast_publish*>(ro);
+  *arg = agnocast_publish{};
+  arg->topic_handle = pub.handle;
+  arg->publisher_id = pub.id;
+  arg->addr = reg.addr + 128;
+  arg->wake_ids = uptr(wake);
+  arg->wake_capacity = 4;
+  arg->reclaim = uptr(reclaim);
+  arg->reclaim_capacity = 4;
+  ASSERT_EQ(mprotect(ro, page, PROT_READ), 0);
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, arg), -EFAULT);
+  EXPECT_TRUE(unchanged());
+  munmap(ro, page);
+
+  // The reclaimable address was not lost on the way: the next publish returns it.
+  ASSERT_EQ(publish(dev, pub, reg.addr + 128, &res), 0);
+  ASSERT_EQ(res.reclaim.size(), 1u);
+  EXPECT_EQ(res.reclaim[0], reg.addr);
+}

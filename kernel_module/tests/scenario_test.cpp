@@ -277,7 +277,7 @@ TEST_F(Scenario, ManyThreadsKilledTogether) {
           [](void* p) -> void* {
             int fd = *static_cast<int*>(p);
             for (;;) {
-              agnocast_list_topics l{0, 0, 0};
+              agnocast_list_topics l{0, 0, 0, 0, 0};
               ioctl(fd, AGNOCAST_IOC_LIST_TOPICS, &l);
             }
           },
@@ -371,6 +371,35 @@ TEST_F(Scenario, ExecDropsTheOldRegistration) {
   EXPECT_EQ(recs[2].subscriber_id, 1u);
 }
 
+// exec is detected when it happens: the new program makes no agnocast call,
+// yet the old registration is gone (and its exit records queued) while it runs.
+TEST_F(Scenario, ExecIsDetectedAtExec) {
+  Pipe registered;
+  pid_t child = fork();
+  if (child == 0) {
+    int d = open_device(O_RDWR);
+    Registration r;
+    Endpoint sub;
+    if (r.full(d) || add_subscriber(d, "/exec_now", 1, &sub)) _exit(10);
+    registered.notify();
+    execl("/proc/self/exe", "scenario", "--pause-child", nullptr);
+    _exit(11);
+  }
+  ASSERT_TRUE(registered.wait());
+  agnocast_topic_info info;
+  ASSERT_TRUE(eventually([&] { return topic_info(dev, "/exec_now", &info) == -ENOENT; }));
+  EXPECT_FALSE(process_listed(dev, child));
+  EXPECT_EQ(waitpid(child, nullptr, WNOHANG), 0);  // still running the new program
+  auto recs = records_of(child);
+  ASSERT_EQ(recs.size(), 2u);
+  EXPECT_EQ(recs[0].kind, static_cast<uint32_t>(AGNOCAST_EXIT_QUEUE));
+  EXPECT_STREQ(recs[0].topic, "/exec_now");
+  EXPECT_EQ(recs[1].kind, static_cast<uint32_t>(AGNOCAST_EXIT_PROCESS));
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  EXPECT_TRUE(records_of(child).empty());  // no registration left to report
+}
+
 // After exec: the inherited descriptor still works, but the registration is
 // gone; registering again succeeds.
 int exec_child(int fd) {
@@ -435,7 +464,7 @@ TEST(Namespace, IpcNamespacesAreIsolated) {
   EXPECT_EQ(in_child([&] {
               if (unshare(CLONE_NEWIPC)) return 10;
               int d = open_device();
-              agnocast_list_topics l{0, 0, 0xA5A5A5A5u};
+              agnocast_list_topics l{0, 0, 0xA5A5A5A5u, 0, 0};
               if (ioc(d, AGNOCAST_IOC_LIST_TOPICS, &l) || l.total != 0) return 11;
               agnocast_topic_info info;
               if (topic_info(d, "/ns/topic", &info) != -ENOENT) return 12;
@@ -465,6 +494,10 @@ TEST(Namespace, IpcNamespacesAreIsolated) {
 
 int main(int argc, char** argv) {
   if (argc == 3 && std::string(argv[1]) == "--exec-child") return exec_child(std::atoi(argv[2]));
+  if (argc == 2 && std::string(argv[1]) == "--pause-child") {
+    pause();  // a new program that never touches agnocast
+    return 0;
+  }
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }

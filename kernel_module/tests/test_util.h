@@ -37,6 +37,16 @@ T poisoned()
   return value;
 }
 
+// Poisoned but for flags and reserved, which a request must leave zero.
+template <class T>
+T poisoned_request()
+{
+  T value = poisoned<T>();
+  value.flags = 0;
+  value.reserved = 0;
+  return value;
+}
+
 inline int open_device(int flags = O_RDWR)
 {
   return ::open(AGNOCAST_DEVICE_PATH, flags | O_CLOEXEC);
@@ -64,7 +74,7 @@ struct Registration {
   int reserve(int device)
   {
     dev = device;
-    agnocast_register_process reg = poisoned<agnocast_register_process>();
+    agnocast_register_process reg = poisoned_request<agnocast_register_process>();
     reg.pool_fd = -1;
     int ret = ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg);
     if (ret) return ret;
@@ -87,7 +97,7 @@ struct Registration {
     if (seals && fcntl(memfd, F_ADD_SEALS, seals)) return -errno;
     // As libagnocast does: nobody but root may reopen it read-write.
     if (fchmod(memfd, 0444)) return -errno;
-    agnocast_register_process reg = poisoned<agnocast_register_process>();
+    agnocast_register_process reg = poisoned_request<agnocast_register_process>();
     reg.pool_fd = memfd;
     return ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg);
   }
@@ -203,7 +213,7 @@ inline int receive(int dev, Endpoint sub, ReceiveResult *res, uint32_t entry_cap
   arg.pools = uptr(pools.data());
   arg.entry_capacity = entry_capacity;
   arg.pool_capacity = pool_capacity;
-  arg.reserved = 0;
+  arg.release_count = 0;
   int ret = ioc(dev, AGNOCAST_IOC_RECEIVE, &arg);
   if (!ret) {
     res->entries.assign(entries.begin(), entries.begin() + arg.entry_count);
@@ -213,10 +223,16 @@ inline int receive(int dev, Endpoint sub, ReceiveResult *res, uint32_t entry_cap
   return ret;
 }
 
+inline int release_list(int dev, Endpoint sub, const std::vector<uint64_t> &entry_ids)
+{
+  agnocast_release arg{sub.handle, sub.id, uptr(entry_ids.data()),
+                       static_cast<uint32_t>(entry_ids.size()), 0};
+  return ioc(dev, AGNOCAST_IOC_RELEASE, &arg);
+}
+
 inline int release(int dev, Endpoint sub, uint64_t entry_id)
 {
-  agnocast_release arg{sub.handle, sub.id, entry_id};
-  return ioc(dev, AGNOCAST_IOC_RELEASE, &arg);
+  return release_list(dev, sub, {entry_id});
 }
 
 inline int topic_info(int dev, const std::string &name, agnocast_topic_info *info,
@@ -241,7 +257,7 @@ inline int topic_info(int dev, const std::string &name, agnocast_topic_info *inf
 inline std::vector<agnocast_process_info> list_processes(int dev)
 {
   std::vector<agnocast_process_info> procs(1024);
-  agnocast_list_processes arg{uptr(procs.data()), 1024, 0};
+  agnocast_list_processes arg{uptr(procs.data()), 1024, 0, 0, 0};
   if (ioc(dev, AGNOCAST_IOC_LIST_PROCESSES, &arg)) return {};
   procs.resize(std::min(arg.total, 1024u));
   return procs;

@@ -302,7 +302,7 @@ TEST_F(Trust, ShedTakesOnlyUnheldEntriesOutsideTheWindow) {
   ASSERT_EQ(add_subscriber(dev, "/shed", 1024, &holder, AGNOCAST_POLLING), 0);
   for (int i = 0; i < 10; i++) ASSERT_EQ(publish(dev, pub, reg.addr + 64 * i), 0);
   // The holder takes the newest (and passes over the older ones): it holds one.
-  auto take = poisoned<agnocast_take>();
+  auto take = poisoned_request<agnocast_take>();
   take.topic_handle = holder.handle;
   take.subscriber_id = holder.id;
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), 0);

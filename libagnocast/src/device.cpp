@@ -363,7 +363,8 @@ ReclaimResult Device::reclaim(std::span<std::uint64_t> reclaim) {
 }
 
 ReceiveResult Device::receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                              std::span<PoolGrant> pools) {
+                              std::span<PoolGrant> pools,
+                              std::span<const std::uint64_t> release_ids) {
   // On the stack: this runs for every wake-up.
   std::array<agnocast_entry, receive_entries_max> raw_entries;
   std::array<agnocast_pool, receive_pools_max> raw_pools;
@@ -375,6 +376,8 @@ ReceiveResult Device::receive(EndpointId subscriber, std::span<ReceivedEntry> en
       static_cast<std::uint32_t>(std::min(entries.size(), raw_entries.size()));
   argument.pools = reinterpret_cast<std::uintptr_t>(raw_pools.data());
   argument.pool_capacity = static_cast<std::uint32_t>(std::min(pools.size(), raw_pools.size()));
+  argument.release_ids = reinterpret_cast<std::uintptr_t>(release_ids.data());
+  argument.release_count = static_cast<std::uint32_t>(release_ids.size());
   if (int err = call(fd_, AGNOCAST_IOC_RECEIVE, &argument)) fail("RECEIVE", err);
   for (std::uint32_t i = 0; i < argument.entry_count; ++i) {
     entries[i] =
@@ -403,11 +406,12 @@ TakeResult Device::take(EndpointId subscriber) {
   return result;
 }
 
-void Device::release(EndpointId subscriber, std::uint64_t entry_id) {
+void Device::release(EndpointId subscriber, std::span<const std::uint64_t> entry_ids) {
   agnocast_release argument{};
   argument.topic_handle = subscriber.topic_handle;
   argument.subscriber_id = subscriber.id;
-  argument.entry_id = entry_id;
+  argument.entry_ids = reinterpret_cast<std::uintptr_t>(entry_ids.data());
+  argument.count = static_cast<std::uint32_t>(entry_ids.size());
   if (int err = call(fd_, AGNOCAST_IOC_RELEASE, &argument)) fail("RELEASE", err);
 }
 

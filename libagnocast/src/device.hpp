@@ -65,9 +65,10 @@ class Device final : public Kernel {
   ReclaimResult reclaim(std::span<std::uint64_t> reclaim) override;
   std::uint32_t shed() override;
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                        std::span<PoolGrant> pools) override;
+                        std::span<PoolGrant> pools,
+                        std::span<const std::uint64_t> release_ids) override;
   TakeResult take(EndpointId subscriber) override;
-  void release(EndpointId subscriber, std::uint64_t entry_id) override;
+  void release(EndpointId subscriber, std::span<const std::uint64_t> entry_ids) override;
 
   // The IPC namespace's topic access policy; nullopt when none is in force.
   std::optional<AccessPolicy> get_policy() const;

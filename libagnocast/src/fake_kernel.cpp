@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <set>
 
 #include "agnocast/errors.hpp"
 
@@ -214,12 +215,14 @@ std::uint32_t FakeKernel::shed() {
 }
 
 ReceiveResult FakeKernel::receive(EndpointId subscriber_id, std::span<ReceivedEntry> entries,
-                                  std::span<PoolGrant> pools) {
+                                  std::span<PoolGrant> pools,
+                                  std::span<const std::uint64_t> release_ids) {
   std::lock_guard lock(mutex_);
   ++calls_.receive;
-  if (entries.empty() || pools.empty()) fail("RECEIVE", EINVAL);
+  if (entries.empty() || pools.empty() || release_ids.size() > release_max) fail("RECEIVE", EINVAL);
   Subscriber& subscriber = subscriber_of(subscriber_id);
   if (subscriber.polling) fail("RECEIVE", EINVAL);
+  release_held("RECEIVE", subscriber, release_ids);
   ReceiveResult result;
   const std::size_t capacity = std::min(entries.size(), receive_entries_max);
   while (result.entry_count < capacity && !subscriber.unreceived.empty()) {
@@ -261,16 +264,26 @@ TakeResult FakeKernel::take(EndpointId subscriber_id) {
   return result;
 }
 
-void FakeKernel::release(EndpointId subscriber_id, std::uint64_t entry_id) {
+void FakeKernel::release(EndpointId subscriber_id, std::span<const std::uint64_t> entry_ids) {
   std::lock_guard lock(mutex_);
   ++calls_.release;
   if (release_error_) fail("RELEASE", release_error_);
-  Subscriber& subscriber = subscriber_of(subscriber_id);
-  const auto held = subscriber.held.find(entry_id);
-  if (held == subscriber.held.end()) fail("RELEASE", ENOENT);
-  subscriber.held.erase(held);
-  --entries_[entry_id].held_by;
-  settle(entry_id);
+  if (entry_ids.empty() || entry_ids.size() > release_max) fail("RELEASE", EINVAL);
+  release_held("RELEASE", subscriber_of(subscriber_id), entry_ids);
+}
+
+void FakeKernel::release_held(const char* call, Subscriber& subscriber,
+                              std::span<const std::uint64_t> entry_ids) {
+  std::set<std::uint64_t> listed;
+  for (const std::uint64_t entry_id : entry_ids) {
+    if (!subscriber.held.contains(entry_id) || !listed.insert(entry_id).second) fail(call, ENOENT);
+  }
+  for (const std::uint64_t entry_id : entry_ids) {
+    subscriber.held.erase(subscriber.held.find(entry_id));
+    --entries_[entry_id].held_by;
+    settle(entry_id);
+    ++calls_.released_entries;
+  }
 }
 
 bool FakeKernel::topic_info(const std::string& name, TopicInfo& info) {

@@ -28,6 +28,8 @@ class FakeKernel final : public Kernel {
     int receive = 0;
     int take = 0;
     int release = 0;
+    // Entries released: by release() and by receive()'s release lists.
+    int released_entries = 0;
     int reclaim = 0;
     int shed = 0;
   };
@@ -42,9 +44,10 @@ class FakeKernel final : public Kernel {
   ReclaimResult reclaim(std::span<std::uint64_t> reclaim) override;
   std::uint32_t shed() override;
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                        std::span<PoolGrant> pools) override;
+                        std::span<PoolGrant> pools,
+                        std::span<const std::uint64_t> release_ids) override;
   TakeResult take(EndpointId subscriber) override;
-  void release(EndpointId subscriber, std::uint64_t entry_id) override;
+  void release(EndpointId subscriber, std::span<const std::uint64_t> entry_ids) override;
   bool topic_info(const std::string& topic, TopicInfo& info) override;
   void close() noexcept override {}
 
@@ -101,6 +104,9 @@ class FakeKernel final : public Kernel {
   // Drops one reference kind of an entry; an unreferenced entry becomes reclaimable.
   void settle(std::uint64_t entry_id);
   void drop_unreceived(Subscriber& subscriber, std::uint64_t entry_id);
+  // Drops held entries, all or none, as RELEASE does; call names the failing call.
+  void release_held(const char* call, Subscriber& subscriber,
+                    std::span<const std::uint64_t> entry_ids);
 
   mutable std::mutex mutex_;
   pid_t caller_pid_;

@@ -70,6 +70,8 @@ class Kernel {
   // The most entries and pool grants one receive() returns; larger spans are not filled further.
   static constexpr std::size_t receive_entries_max = 32;
   static constexpr std::size_t receive_pools_max = 8;
+  // The most ids one release(), or the release list of one receive(), names.
+  static constexpr std::size_t release_max = 256;
 
   virtual EndpointId add_publisher(const EndpointRequest& request) = 0;
   virtual EndpointId add_subscriber(const EndpointRequest& request) = 0;
@@ -86,12 +88,16 @@ class Kernel {
   // the publisher's depth; returns how many. Reclaim afterwards.
   virtual std::uint32_t shed() = 0;
 
-  // Callback subscribers: the oldest unreceived entries, now held until release().
+  // Callback subscribers: drops the held entries release_ids (all or none, at
+  // most release_max), then receives the oldest unreceived entries, now held
+  // until released; an error releases and receives nothing.
   virtual ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                                std::span<PoolGrant> pools) = 0;
+                                std::span<PoolGrant> pools,
+                                std::span<const std::uint64_t> release_ids) = 0;
   // Polling subscribers: the newest unreceived entry, held until release().
   virtual TakeResult take(EndpointId subscriber) = 0;
-  virtual void release(EndpointId subscriber, std::uint64_t entry_id) = 0;
+  // Drops held entries, all or none (1..release_max ids).
+  virtual void release(EndpointId subscriber, std::span<const std::uint64_t> entry_ids) = 0;
 
   // The topic's endpoints and counters; false when no endpoint uses it.
   virtual bool topic_info(const std::string& topic, TopicInfo& info) = 0;

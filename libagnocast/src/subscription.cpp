@@ -1,7 +1,10 @@
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <span>
+#include <utility>
 
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
@@ -17,8 +20,15 @@ namespace {
 
 // The kernel subscriber. It outlives its Subscription while any received
 // message is still held, so that memory is never reclaimed under a reader.
+// A callback subscriber's releases made while it handles a wake-up (messages
+// dropped by its callbacks) wait for its next receive, which drops them in
+// the same system call; a full batch, and any other release, goes at once.
 class SubscriberEndpoint : public EntryOwner {
  public:
+  // Releases one receive carries; a full batch is released at once.
+  static constexpr std::size_t release_batch = 32;
+  using ReleaseBatch = std::array<std::uint64_t, release_batch>;
+
   SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
       : runtime_(runtime), id_(runtime.kernel().add_subscriber(request)) {}
 
@@ -34,12 +44,37 @@ class SubscriberEndpoint : public EntryOwner {
 
   void release_entry(std::uint64_t entry_id) noexcept override {
     if (!still_ours()) return;
+    std::lock_guard lock(release_mutex_);
+    pending_releases_[pending_count_++] = entry_id;
+    if (handling_wakeup_ && pending_count_ < release_batch) return;
     try {
-      runtime_.kernel().release(id_, entry_id);
+      runtime_.kernel().release(id_, std::span(pending_releases_.data(), pending_count_));
     } catch (const Error& error) {
       // Called when the last pointer to a message goes: nobody to throw to.
       log(LogLevel::warning, std::string("releasing a received message: ") + error.what());
     }
+    pending_count_ = 0;
+  }
+
+  // While set (by the thread receiving, under the subscription's receive
+  // mutex), releases wait for the next receive.
+  void set_handling_wakeup(bool handling) {
+    std::lock_guard lock(release_mutex_);
+    handling_wakeup_ = handling;
+  }
+
+  // Moves the releases waiting for the next receive into batch; returns their number.
+  std::size_t take_releases(ReleaseBatch& batch) {
+    std::lock_guard lock(release_mutex_);
+    const std::size_t count = std::exchange(pending_count_, 0);
+    std::copy_n(pending_releases_.begin(), count, batch.begin());
+    return count;
+  }
+
+  // A failed receive released nothing: the ids wait for the next one, or
+  // are released now if newer ones filled the batch meanwhile.
+  void return_releases(std::span<const std::uint64_t> ids) noexcept {
+    for (const std::uint64_t id : ids) release_entry(id);
   }
 
   EntryReference* reference_to(std::uint64_t entry_id, std::shared_ptr<EntryOwner> self) {
@@ -58,6 +93,10 @@ class SubscriberEndpoint : public EntryOwner {
 
   Runtime& runtime_;
   const EndpointId id_;
+  std::mutex release_mutex_;
+  bool handling_wakeup_ = false;
+  ReleaseBatch pending_releases_{};
+  std::size_t pending_count_ = 0;
 };
 
 // Maps every granted pool (closing each descriptor) and throws the first failure.
@@ -139,8 +178,23 @@ std::size_t SubscriptionBase::handle_wakeup() {
   // receive, and no publish came since (a queue of one slot may have refused
   // a later notification, so it always receives again).
   bool drained = false;
+  SubscriberEndpoint::ReleaseBatch releases;
+  SubscriberEndpoint& endpoint = *state.endpoint;
+  endpoint.set_handling_wakeup(true);
+  struct StopDeferring {
+    SubscriberEndpoint& endpoint;
+    ~StopDeferring() { endpoint.set_handling_wakeup(false); }
+  } stop_deferring{endpoint};
   for (;;) {
-    const ReceiveResult result = runtime.kernel().receive(state.endpoint->id(), entries, pools);
+    const std::span<const std::uint64_t> released(releases.data(),
+                                                  state.endpoint->take_releases(releases));
+    ReceiveResult result;
+    try {
+      result = runtime.kernel().receive(state.endpoint->id(), entries, pools, released);
+    } catch (...) {
+      state.endpoint->return_releases(released);
+      throw;
+    }
     std::array<EntryReference*, Kernel::receive_entries_max> references;
     for (std::uint32_t i = 0; i < result.entry_count; ++i) {
       references[i] = state.endpoint->reference_to(entries[i].entry_id, state.endpoint);

@@ -24,6 +24,16 @@
  *
  * State is per IPC namespace: topics, ids and exit records of one namespace
  * are invisible from another.
+ *
+ * Only 64-bit processes can use the device: pools live above 4 GiB, so there
+ * is no compat_ioctl and a 32-bit caller gets -ENOTTY.
+ *
+ * Answers are staged: every output buffer a command names is checked
+ * writable before the command changes anything (-EFAULT then, and nothing
+ * happened) and written after the kernel's locks are dropped.  Should another
+ * thread unmap an output buffer in between, the command has happened and
+ * still returns 0; what it could not write is lost, except reclaimable
+ * addresses, which stay pending.
  */
 #ifndef _UAPI_LINUX_AGNOCAST_H
 #define _UAPI_LINUX_AGNOCAST_H
@@ -35,7 +45,7 @@
 
 /* The module and the library must agree on major and minor. */
 #define AGNOCAST_VERSION_MAJOR 0
-#define AGNOCAST_VERSION_MINOR 2
+#define AGNOCAST_VERSION_MINOR 3
 #define AGNOCAST_VERSION_PATCH 0
 
 /* Including the terminating NUL. */
@@ -101,6 +111,8 @@ struct agnocast_register_process {
 	__s32 pid;
 	__u64 pool_addr;
 	__u64 pool_size;
+	__u32 flags;		/* none defined: must be 0 */
+	__u32 reserved;
 };
 
 /*
@@ -179,6 +191,15 @@ struct agnocast_remove_endpoint {
  * current subscriber's unreceived list; a subscriber over its depth loses its
  * oldest unreceived entry, counted as dropped.
  *
+ * All or nothing: every error is returned before the entry is published.
+ * wake_ids (its first min(wake_capacity, SUBSCRIBERS_PER_TOPIC_MAX) slots),
+ * reclaim (its first min(reclaim_capacity, AGNOCAST_RECLAIM_BATCH) slots) and
+ * the argument itself are checked writable first; an unwritable one is
+ * -EFAULT with nothing published and nothing reclaimed.  Once published, the
+ * call returns 0 (see "Answers are staged" above).  At most
+ * AGNOCAST_RECLAIM_BATCH addresses are returned per call; reclaim_pending
+ * counts the rest.
+ *
  *   -EFAULT  addr is outside the caller's pool
  *   -ENOBUFS wake_capacity is below the topic's subscriber count
  *   -EBUSY   the caller's pool is not attached yet
@@ -198,6 +219,9 @@ struct agnocast_publish {
 	__u32 reclaim_pending;
 	__u32 reserved;
 };
+
+/* Most reclaimable addresses one PUBLISH or RECLAIM returns. */
+#define AGNOCAST_RECLAIM_BATCH 32
 
 /*
  * AGNOCAST_IOC_RECLAIM: only the reclaim part of PUBLISH.
@@ -230,19 +254,35 @@ struct agnocast_pool {
 	__s32 pid;
 };
 
+/* Most entry ids one RELEASE, or the release list of one RECEIVE, names. */
+#define AGNOCAST_RELEASE_MAX 256
+/* Most entries and pools one RECEIVE returns (remaining counts the rest). */
+#define AGNOCAST_RECEIVE_ENTRIES_MAX 256
+#define AGNOCAST_RECEIVE_POOLS_MAX 8
+
 /*
  * AGNOCAST_IOC_RECEIVE (callback subscribers)
  *
  * in:  entries/entry_capacity, pools/pool_capacity (arrays of the structs
- *      above).
- * out: up to entry_capacity unreceived entries, oldest first, now held by the
- *      subscriber until RELEASE; the pools they live in that the caller has
- *      not been given; remaining, how many unreceived entries are left.
+ *      above); release_ids/release_count, a __u64 array of entry ids the
+ *      subscriber holds and drops first, as RELEASE would (release_count 0:
+ *      none), so that a subscriber's steady state needs no RELEASE call.
+ * out: up to entry_capacity (at most RECEIVE_ENTRIES_MAX) unreceived
+ *      entries, oldest first, now held by the subscriber until released; the
+ *      pools they live in that the caller has not been given (at most
+ *      pool_capacity, at most RECEIVE_POOLS_MAX: receiving stops before an
+ *      entry whose pool does not fit); remaining, how many unreceived entries
+ *      are left.
  *
- *   -EINVAL  entry_capacity or pool_capacity is zero
- *   -EDQUOT  unreceived entries wait but the subscriber already holds
- *            max_held_per_subscriber entries (module parameter): RELEASE
- *            some first
+ * The releases and the receive are one: any error leaves every listed entry
+ * held and receives nothing.
+ *
+ *   -EINVAL  entry_capacity or pool_capacity is zero, release_count is over
+ *            AGNOCAST_RELEASE_MAX
+ *   -ENOENT  also: a listed id is not held by the subscriber (or listed twice)
+ *   -EDQUOT  unreceived entries wait but the subscriber holds
+ *            max_held_per_subscriber entries (module parameter) even after
+ *            the releases: release some first
  */
 struct agnocast_receive {
 	__u32 topic_handle;
@@ -254,17 +294,22 @@ struct agnocast_receive {
 	__u32 entry_count;
 	__u32 pool_count;
 	__u32 remaining;
-	__u32 reserved;
+	__u32 release_count;
+	__u64 release_ids;
 };
 
 /*
  * AGNOCAST_IOC_TAKE (polling subscribers)
  *
+ * in:  flags, none defined: must be 0.
  * out: the newest unreceived entry, held until RELEASE (entry_count 1), or
  *      nothing (entry_count 0).  Older unreceived entries are passed over.
  *      pool is filled (pool_count 1) when the caller has not been given it.
  *
  *   -EDQUOT  as for RECEIVE
+ *   -EAGAIN  the newest entry moved to a pool not yet given four times over
+ *            while its pool was being installed (publishers restarting
+ *            faster than the call); try again
  */
 struct agnocast_take {
 	__u32 topic_handle;
@@ -273,17 +318,24 @@ struct agnocast_take {
 	struct agnocast_pool pool;
 	__u32 entry_count;
 	__u32 pool_count;
+	__u32 flags;
+	__u32 reserved;
 };
 
 /*
- * AGNOCAST_IOC_RELEASE: the subscriber drops its reference to entry_id.
+ * AGNOCAST_IOC_RELEASE: the subscriber drops its references to the count
+ * entry ids at entry_ids (1..AGNOCAST_RELEASE_MAX), all or none.
  *
- *   -ENOENT  the subscriber does not hold that entry
+ *   -EINVAL  count is 0 or over AGNOCAST_RELEASE_MAX, flags is not 0
+ *   -ENOENT  the subscriber does not hold one of them (or it is listed
+ *            twice); none is released
  */
 struct agnocast_release {
 	__u32 topic_handle;
 	__u32 subscriber_id;
-	__u64 entry_id;
+	__u64 entry_ids;
+	__u32 count;
+	__u32 flags;
 };
 
 /*
@@ -393,6 +445,8 @@ struct agnocast_list_topics {
 	__u64 topics;
 	__u32 capacity;
 	__u32 total;
+	__u32 flags;		/* none defined: must be 0 */
+	__u32 reserved;
 };
 
 /* uid: the owning process's effective uid when it registered. */
@@ -479,6 +533,8 @@ struct agnocast_list_processes {
 	__u64 processes;
 	__u32 capacity;
 	__u32 total;
+	__u32 flags;		/* none defined: must be 0 */
+	__u32 reserved;
 };
 
 #define AGNOCAST_IOC_MAGIC 0xAC
@@ -513,8 +569,10 @@ struct agnocast_list_processes {
  * AGNOCAST_EXIT_RECORDS_MAX the oldest are discarded, and the next read
  * starts with one AGNOCAST_EXIT_LOST record whose subscriber_id is how many
  * were discarded: the reader must then look for leftovers itself.  Reading needs
- * CAP_SYS_ADMIN in the namespace's user namespace (-EPERM otherwise); a
- * buffer smaller than one record is -EINVAL; with none waiting, read blocks
+ * a descriptor opened with CAP_SYS_ADMIN in the user namespace of the IPC
+ * namespace it was opened in (-EPERM otherwise; decided at open, like a
+ * file's permissions, and valid for whoever holds the descriptor); it reads
+ * that namespace's records.  A buffer smaller than one record is -EINVAL; with none waiting, read blocks
  * or, with O_NONBLOCK, fails with -EAGAIN.
  *
  * A dead process yields one AGNOCAST_EXIT_PROCESS record, preceded by one

@@ -1,0 +1,744 @@
+// SPDX-License-Identifier: GPL-2.0
+/*
+ * agnocast: the endpoint and data-path commands.
+ *
+ * Each handler copies its argument in, calls down into topics
+ * (agnocast_topic.c) and the entry engine (agnocast_entry.c) under the
+ * namespace lock, and copies the answer out.  Nothing below calls back here.
+ */
+#include <linux/fdtable.h>
+#include <linux/file.h>
+#include <linux/version.h>
+#include <linux/minmax.h>
+#include <linux/pagemap.h>
+#include <linux/slab.h>
+#include <linux/string.h>
+#include <linux/uaccess.h>
+
+#include "agnocast_internal.h"
+
+/* Entries a RECEIVE handles without allocating; 4 keeps the frame small. */
+#define AGNOCAST_RECEIVE_SMALL 4
+/* Subscribers a PUBLISH wakes without allocating. */
+#define AGNOCAST_WAKE_SMALL 16
+/* Entry ids a RELEASE or RECEIVE releases without allocating. */
+#define AGNOCAST_RELEASE_SMALL 8
+
+static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
+				 bool publisher)
+{
+	struct agnocast_add_endpoint __user *uendpoint = uarg;
+	struct agnocast_add_endpoint *arg;
+	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
+	struct agnocast_ctx ctx;
+	void *schema = NULL;
+	int ret;
+
+	arg = memdup_user(uarg, sizeof(*arg));
+	if (IS_ERR(arg))
+		return PTR_ERR(arg);
+	ret = -EINVAL;
+	if (!agnocast_endpoint_args_valid(arg, publisher))
+		goto out_free_arg;
+	if (arg->schema_size) {
+		schema = kvmalloc(arg->schema_size, GFP_KERNEL_ACCOUNT);
+		ret = -ENOMEM;
+		if (!schema)
+			goto out_free_arg;
+		ret = -EFAULT;
+		if (copy_from_user(schema, u64_to_user_ptr(arg->schema), arg->schema_size))
+			goto out_free_arg;
+	}
+
+	ret = agnocast_enter(&ctx, file_ns, true, true);
+	if (ret)
+		goto out_free_arg;
+	ret = agnocast_policy_check(ctx.ns, arg->topic, publisher);
+	if (ret)
+		goto out_leave;
+	ret = -EMFILE;
+	if (ctx.proc->nr_publishers + ctx.proc->nr_subscribers >=
+	    agnocast_max_endpoints_per_process)
+		goto out_leave;
+	topic = agnocast_topic_get(ctx.ns, arg->topic);
+	if (IS_ERR(topic)) {
+		ret = PTR_ERR(topic);
+		goto out_leave;
+	}
+	ret = agnocast_topic_type_check(topic, arg, &schema);
+	if (ret)
+		goto out_put_topic;
+	ret = -ENOSPC;
+	if (publisher ? topic->nr_publishers >= AGNOCAST_PUBLISHERS_PER_TOPIC_MAX :
+			topic->nr_subscribers >= AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX)
+		goto out_put_topic;
+	if (topic->ids->next_id == U32_MAX)
+		goto out_put_topic;
+	ret = -ENOMEM;
+	ep = agnocast_endpoint_create(topic, ctx.proc, arg, publisher);
+	if (!ep)
+		goto out_put_topic;
+
+	/* Report before committing: a bad buffer must not leave an endpoint. */
+	ret = -EFAULT;
+	if (put_user(topic->handle, &uendpoint->topic_handle) ||
+	    put_user(ep->id, &uendpoint->id)) {
+		agnocast_endpoint_abandon(ep);
+		goto out_put_topic;
+	}
+	agnocast_endpoint_commit(ep);
+	ret = 0;
+	goto out_leave;
+
+out_put_topic:
+	agnocast_topic_maybe_free(topic);
+out_leave:
+	agnocast_leave(&ctx);
+out_free_arg:
+	kvfree(schema);
+	kfree(arg);
+	return ret;
+}
+
+int agnocast_add_publisher(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	return agnocast_add_endpoint(file_ns, uarg, true);
+}
+
+int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	return agnocast_add_endpoint(file_ns, uarg, false);
+}
+
+static int agnocast_remove_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
+				    bool publisher)
+{
+	struct agnocast_remove_endpoint arg;
+	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
+	struct agnocast_ctx ctx;
+	int ret;
+
+	if (copy_from_user(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	ret = agnocast_enter(&ctx, file_ns, true, true);
+	if (ret)
+		return ret;
+	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.id, publisher, &ep);
+	if (!ret) {
+		topic = ep->topic;
+		agnocast_endpoint_destroy(ep);
+		agnocast_topic_maybe_free(topic);
+	}
+	agnocast_leave(&ctx);
+	return ret;
+}
+
+int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	return agnocast_remove_endpoint(file_ns, uarg, true);
+}
+
+int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	return agnocast_remove_endpoint(file_ns, uarg, false);
+}
+
+
+/*
+ * Output buffers are checked writable before anything commits, so that a
+ * call fails with -EFAULT only while it has done nothing.  They are written
+ * after the namespace lock is dropped; should another thread unmap them in
+ * between, the call still reports success (it happened) and what it could
+ * not write is lost, except reclaimable addresses, which stay pending.
+ */
+static int agnocast_out_writable(u64 ubuf, size_t bytes)
+{
+	char __user *p = u64_to_user_ptr(ubuf);
+
+	if (!bytes)
+		return 0;
+	return access_ok(p, bytes) && !fault_in_safe_writeable(p, bytes) ? 0 : -EFAULT;
+}
+
+/* Writes an answer after commit; a failure loses only the answer (see above). */
+static bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
+{
+	return !copy_to_user(to, from, bytes);
+}
+
+/*
+ * An unwritable output is -EFAULT, but an unregistered caller learns that
+ * first, as it would if the buffers were fine.
+ */
+static int agnocast_unwritable(struct agnocast_ns *file_ns)
+{
+	struct agnocast_ctx ctx;
+	int ret;
+
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		return ret;
+	agnocast_leave(&ctx);
+	return -EFAULT;
+}
+
+/* Probes a field of the argument for writing, keeping its value. */
+#define agnocast_arg_writable(ufield, value) (put_user(value, ufield) ? -EFAULT : 0)
+
+/*
+ * Addresses whose copy-out failed go back to the caller's reclaim list, if
+ * the caller is still registered with the pool they belong to.
+ */
+static void agnocast_reclaim_copy_out(struct agnocast_ns *file_ns, u64 ubuf, const u64 *addrs,
+				      u32 n)
+{
+	struct agnocast_mempool *pool;
+	struct agnocast_ctx ctx;
+
+	if (!n || agnocast_answer_out(u64_to_user_ptr(ubuf), addrs, n * sizeof(*addrs)))
+		return;
+	if (agnocast_enter(&ctx, file_ns, true, false))
+		return;
+	pool = ctx.proc->pool;
+	if (addrs[0] >= pool->addr && addrs[0] - pool->addr < pool->size)
+		agnocast_reclaim_return(ctx.proc, addrs, n);
+	agnocast_leave(&ctx);
+}
+
+int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_publish __user *upublish = uarg;
+	u64 reclaim[AGNOCAST_RECLAIM_BATCH];
+	u32 wake_small[AGNOCAST_WAKE_SMALL];
+	struct agnocast_topic_entry *entry;
+	struct agnocast_publish arg;
+	struct agnocast_endpoint *ep;
+	struct agnocast_publisher *pub;
+	struct agnocast_mempool *pool;
+	struct agnocast_topic *topic;
+	struct agnocast_ctx ctx;
+	u32 *wake = wake_small;
+	u32 wake_max, reclaim_max, wake_count = 0;
+	int ret;
+
+	if (copy_from_user(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	if (arg.reserved)
+		return -EINVAL;
+	wake_max = min_t(u32, arg.wake_capacity, AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX);
+	reclaim_max = min_t(u32, arg.reclaim_capacity, AGNOCAST_RECLAIM_BATCH);
+	if (agnocast_out_writable(arg.wake_ids, wake_max * sizeof(u32)) ||
+	    agnocast_out_writable(arg.reclaim, reclaim_max * sizeof(u64)) ||
+	    agnocast_arg_writable(&upublish->reserved, 0))
+		return agnocast_unwritable(file_ns);
+
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		return ret;
+	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.publisher_id, true, &ep);
+	if (ret)
+		goto out_leave;
+	pub = agnocast_to_publisher(ep);
+	topic = ep->topic;
+	pool = ctx.proc->pool;
+	ret = -EBUSY;
+	if (!pool->file)
+		goto out_leave;
+	ret = -EFAULT;
+	if (arg.addr < pool->addr || arg.addr - pool->addr >= pool->size)
+		goto out_leave;
+	ret = -ENOBUFS;
+	if (arg.wake_capacity < topic->nr_callback_subscribers)
+		goto out_leave;
+	ret = -ENOMEM;
+	if (topic->nr_callback_subscribers > ARRAY_SIZE(wake_small)) {
+		wake = kvmalloc_array(topic->nr_callback_subscribers, sizeof(*wake),
+				      GFP_KERNEL_ACCOUNT);
+		if (!wake)
+			goto out_leave;
+	}
+	entry = agnocast_entry_alloc();
+	if (!entry)
+		goto out_leave;
+
+	/* Committed: nothing below fails. */
+	list_for_each_entry(ep, &topic->subscribers, topic_node) {
+		if (!(ep->flags & AGNOCAST_POLLING) && !agnocast_sub_ignores(ep, pub))
+			wake[wake_count++] = ep->id;
+	}
+	mutex_lock(&topic->lock);
+	agnocast_entry_publish(pub, entry, pool, arg.addr, arg.bytes);
+	arg.entry_id = entry->id;
+	mutex_unlock(&topic->lock);
+	arg.wake_count = wake_count;
+	arg.reclaim_count = agnocast_reclaim_take(ctx.proc, reclaim, reclaim_max,
+						  &arg.reclaim_pending);
+	ret = 0;
+out_leave:
+	agnocast_leave(&ctx);
+	if (!ret) {
+		agnocast_reclaim_copy_out(file_ns, arg.reclaim, reclaim, arg.reclaim_count);
+		if (agnocast_answer_out(u64_to_user_ptr(arg.wake_ids), wake,
+					wake_count * sizeof(*wake)))
+			agnocast_answer_out(uarg, &arg, sizeof(arg));
+	}
+	if (wake != wake_small)
+		kvfree(wake);
+	return ret;
+}
+
+int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_reclaim __user *ureclaim = uarg;
+	u64 reclaim[AGNOCAST_RECLAIM_BATCH];
+	struct agnocast_reclaim arg;
+	struct agnocast_ctx ctx;
+	u32 reclaim_max;
+	int ret;
+
+	if (copy_from_user(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	if (arg.reserved)
+		return -EINVAL;
+	reclaim_max = min_t(u32, arg.reclaim_capacity, AGNOCAST_RECLAIM_BATCH);
+	if (agnocast_out_writable(arg.reclaim, reclaim_max * sizeof(u64)) ||
+	    agnocast_arg_writable(&ureclaim->reserved, 0))
+		return agnocast_unwritable(file_ns);
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		return ret;
+	arg.reclaim_count = agnocast_reclaim_take(ctx.proc, reclaim, reclaim_max,
+						  &arg.reclaim_pending);
+	agnocast_leave(&ctx);
+	agnocast_reclaim_copy_out(file_ns, arg.reclaim, reclaim, arg.reclaim_count);
+	agnocast_answer_out(uarg, &arg, sizeof(arg));
+	return 0;
+}
+
+/*
+ * Copies in the @count entry ids at @uids, into @small when they fit, else
+ * into memory to kvfree() when *ids != small.
+ */
+static int agnocast_release_ids_in(u64 uids, u32 count, u64 *small, u64 **ids)
+{
+	*ids = small;
+	if (count > AGNOCAST_RELEASE_MAX)
+		return -EINVAL;
+	if (count > AGNOCAST_RELEASE_SMALL) {
+		*ids = kvmalloc_array(count, sizeof(u64), GFP_KERNEL_ACCOUNT);
+		if (!*ids)
+			return -ENOMEM;
+	}
+	if (copy_from_user(*ids, u64_to_user_ptr(uids), count * sizeof(u64))) {
+		if (*ids != small)
+			kvfree(*ids);
+		*ids = small;
+		return -EFAULT;
+	}
+	return 0;
+}
+
+static void agnocast_entry_out(struct agnocast_entry *out,
+			       const struct agnocast_topic_entry *entry)
+{
+	memset(out, 0, sizeof(*out));
+	out->entry_id = entry->id;
+	out->addr = entry->addr;
+	out->publisher_id = entry->publisher_id;
+}
+
+/*
+ * Pools handed to a subscriber.  Descriptors are installed with receive_fd()
+ * (the kernel's path for passing files, with its security check) while no
+ * lock is held, before the entries that need them are committed: a call that
+ * needs a pool the caller lacks takes a reference on its file, drops the
+ * namespace lock, installs, and locks again.  Entries are then received only
+ * up to the first one whose pool is neither the caller's nor given to it.
+ */
+struct agnocast_grants {
+	struct file *files[AGNOCAST_RECEIVE_POOLS_MAX];
+	struct agnocast_pool out[AGNOCAST_RECEIVE_POOLS_MAX];
+	u32 count;
+	u32 capacity;
+	/* TAKE: a grant replaced by another, to close and put unlocked. */
+	struct file *stale_file;
+	int stale_fd;
+};
+
+static bool agnocast_grants_has(const struct agnocast_grants *grants,
+				const struct agnocast_mempool *pool)
+{
+	u32 i;
+
+	for (i = 0; i < grants->count; i++) {
+		if (grants->files[i] == pool->file)
+			return true;
+	}
+	return false;
+}
+
+/* Whether @proc can read @pool once the grants are committed. */
+static bool agnocast_pool_readable(const struct agnocast_proc *proc,
+				   const struct agnocast_grants *grants,
+				   const struct agnocast_mempool *pool)
+{
+	return !agnocast_pool_needs_giving(proc, pool) || agnocast_grants_has(grants, pool);
+}
+
+/* Adds @pool to the grants to install; false when they are full. */
+static bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_mempool *pool)
+{
+	if (grants->count == grants->capacity)
+		return false;
+	agnocast_pool_describe(pool, &grants->out[grants->count]);
+	grants->files[grants->count++] = get_file(pool->file);
+	return true;
+}
+
+/*
+ * TAKE's one grant: the installed descriptor of a pool the newest entry no
+ * longer needs is closed once no lock is held (agnocast_grants_install()).
+ */
+static void agnocast_grants_add_over(struct agnocast_grants *grants,
+				     struct agnocast_mempool *pool)
+{
+	if (grants->count) {
+		grants->stale_fd = grants->out[0].fd;
+		grants->stale_file = grants->files[0];
+		grants->count = 0;
+	}
+	agnocast_grants_add(grants, pool);
+}
+
+static int agnocast_receive_fd(struct file *file)
+{
+#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 8, 0)
+	return receive_fd(file, NULL, O_CLOEXEC);
+#else
+	return receive_fd(file, O_CLOEXEC);
+#endif
+}
+
+/*
+ * Installs grants @from.. (no lock held); on failure closes and forgets
+ * what this call to it added.
+ */
+static int agnocast_grants_install(struct agnocast_grants *grants, u32 from)
+{
+	u32 i;
+	int fd;
+
+	if (grants->stale_file) {
+		close_fd(grants->stale_fd);
+		fput(grants->stale_file);
+		grants->stale_file = NULL;
+	}
+	for (i = from; i < grants->count; i++) {
+		fd = agnocast_receive_fd(grants->files[i]);
+		if (fd < 0)
+			goto err_undo;
+		grants->out[i].fd = fd;
+	}
+	return 0;
+
+err_undo:
+	while (i-- > from)
+		close_fd(grants->out[i].fd);
+	for (i = from; i < grants->count; i++)
+		fput(grants->files[i]);
+	grants->count = from;
+	return fd;
+}
+
+/* Marks the granted pools given (those still alive); namespace lock held. */
+static void agnocast_grants_commit(struct agnocast_proc *proc,
+				   const struct agnocast_grants *grants)
+{
+	u32 i;
+
+	for (i = 0; i < grants->count; i++)
+		agnocast_pool_mark_given(proc, &grants->out[i], grants->files[i]);
+}
+
+static void agnocast_grants_put(struct agnocast_grants *grants)
+{
+	u32 i;
+
+	for (i = 0; i < grants->count; i++)
+		fput(grants->files[i]);
+}
+
+/* Closes installed descriptors of a call that failed after installing them. */
+static void agnocast_grants_close(struct agnocast_grants *grants)
+{
+	u32 i;
+
+	for (i = 0; i < grants->count; i++)
+		close_fd(grants->out[i].fd);
+}
+
+int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	/* A wake-up usually finds one entry: small receives need no allocation. */
+	struct agnocast_entry entries_small[AGNOCAST_RECEIVE_SMALL];
+	struct agnocast_receive __user *ureceive = uarg;
+	struct agnocast_entry *entries = entries_small;
+	u64 release_small[AGNOCAST_RELEASE_SMALL];
+	u64 *release_ids;
+	struct agnocast_grants grants = {};
+	struct agnocast_subscriber *sub;
+	struct agnocast_receive arg;
+	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
+	struct agnocast_ctx ctx;
+	u32 n, i, entry_max, held_after, installed = 0;
+	int ret;
+
+	if (copy_from_user(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	if (!arg.entry_capacity || !arg.pool_capacity || arg.release_count > AGNOCAST_RELEASE_MAX)
+		return -EINVAL;
+	entry_max = min_t(u32, arg.entry_capacity, AGNOCAST_RECEIVE_ENTRIES_MAX);
+	grants.capacity = min_t(u32, arg.pool_capacity, AGNOCAST_RECEIVE_POOLS_MAX);
+	if (agnocast_out_writable(arg.entries, entry_max * sizeof(*entries)) ||
+	    agnocast_out_writable(arg.pools, grants.capacity * sizeof(struct agnocast_pool)) ||
+	    agnocast_arg_writable(&ureceive->release_count, arg.release_count))
+		return agnocast_unwritable(file_ns);
+	ret = agnocast_release_ids_in(arg.release_ids, arg.release_count, release_small,
+				      &release_ids);
+	if (ret)
+		return ret;
+	if (entry_max > ARRAY_SIZE(entries_small)) {
+		ret = -ENOMEM;
+		entries = kvmalloc_array(entry_max, sizeof(*entries), GFP_KERNEL_ACCOUNT);
+		if (!entries)
+			goto out_free_ids;
+	}
+
+relock:
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		goto out_close;
+	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	if (ret)
+		goto out_leave;
+	sub = agnocast_to_subscriber(ep);
+	topic = ep->topic;
+	mutex_lock(&topic->lock);
+	/* Held entries about to be released count as released already. */
+	ret = -ENOENT;
+	if (arg.release_count > sub->nr_held)
+		goto out_unlock;
+	held_after = sub->nr_held - arg.release_count;
+	n = min(entry_max, sub->nr_unreceived);
+	ret = -EDQUOT;
+	if (held_after >= agnocast_max_held_per_subscriber) {
+		if (n)
+			goto out_unlock;
+	} else {
+		n = min(n, agnocast_max_held_per_subscriber - held_after);
+	}
+	/* Oldest first; stop at an entry whose pool does not fit in the grants. */
+	for (i = 0; i < n; i++) {
+		struct agnocast_mempool *pool = agnocast_sub_unreceived(sub, i)->pool;
+
+		if (!agnocast_pool_readable(ctx.proc, &grants, pool) &&
+		    !agnocast_grants_add(&grants, pool))
+			break;
+	}
+	n = i;
+	if (grants.count > installed) {
+		mutex_unlock(&topic->lock);
+		agnocast_leave(&ctx);
+		ret = agnocast_grants_install(&grants, installed);
+		if (ret)
+			goto out_close;
+		installed = grants.count;
+		goto relock;
+	}
+	ret = agnocast_sub_reserve_held(sub, n, false);
+	if (ret)
+		goto out_unlock;
+	ret = agnocast_sub_release(sub, release_ids, arg.release_count);
+	if (ret) {
+		agnocast_sub_unreserve_held(sub, n, false);
+		goto out_unlock;
+	}
+
+	/* Commit: nothing below fails. */
+	for (i = 0; i < n; i++)
+		agnocast_entry_out(&entries[i], agnocast_sub_unreceived(sub, i));
+	agnocast_grants_commit(ctx.proc, &grants);
+	for (i = 0; i < n; i++)
+		agnocast_sub_hold_oldest(sub);
+	arg.entry_count = n;
+	arg.pool_count = grants.count;
+	arg.remaining = sub->nr_unreceived;
+	mutex_unlock(&topic->lock);
+	agnocast_leave(&ctx);
+	if (agnocast_answer_out(u64_to_user_ptr(arg.entries), entries, n * sizeof(*entries)) &&
+	    agnocast_answer_out(u64_to_user_ptr(arg.pools), grants.out,
+				grants.count * sizeof(grants.out[0])))
+		agnocast_answer_out(uarg, &arg, sizeof(arg));
+	goto out_put;
+
+out_unlock:
+	mutex_unlock(&topic->lock);
+out_leave:
+	agnocast_leave(&ctx);
+out_close:
+	agnocast_grants_close(&grants);
+out_put:
+	agnocast_grants_put(&grants);
+	if (entries != entries_small)
+		kvfree(entries);
+out_free_ids:
+	if (release_ids != release_small)
+		kvfree(release_ids);
+	return ret;
+}
+
+/* Attempts of TAKE to catch a newest entry whose pool it has installed. */
+#define AGNOCAST_TAKE_ATTEMPTS 4
+
+int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_take __user *utake = uarg;
+	struct agnocast_grants grants = { .capacity = 1 };
+	struct agnocast_topic_entry *entry;
+	struct agnocast_subscriber *sub;
+	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
+	struct agnocast_take arg;
+	struct agnocast_ctx ctx;
+	u32 attempts = 0;
+	int ret;
+
+	if (copy_from_user(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	if (arg.flags || arg.reserved)
+		return -EINVAL;
+	if (agnocast_arg_writable(&utake->pool_count, arg.pool_count))
+		return agnocast_unwritable(file_ns);
+
+relock:
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		goto out_close;
+	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	if (ret)
+		goto out_leave;
+	sub = agnocast_to_subscriber(ep);
+	topic = ep->topic;
+	memset(&arg.entry, 0, sizeof(arg.entry));
+	memset(&arg.pool, 0, sizeof(arg.pool));
+	arg.entry_count = 0;
+	arg.pool_count = 0;
+	mutex_lock(&topic->lock);
+	if (sub->nr_unreceived) {
+		ret = -EDQUOT;
+		if (sub->nr_held >= agnocast_max_held_per_subscriber)
+			goto out_unlock;
+		entry = agnocast_sub_unreceived(sub, sub->nr_unreceived - 1);
+		if (!agnocast_pool_readable(ctx.proc, &grants, entry->pool)) {
+			/* Install its pool, then look again: the newest may have moved. */
+			ret = -EAGAIN;
+			if (++attempts > AGNOCAST_TAKE_ATTEMPTS)
+				goto out_unlock;
+			agnocast_grants_add_over(&grants, entry->pool);
+			mutex_unlock(&topic->lock);
+			agnocast_leave(&ctx);
+			ret = agnocast_grants_install(&grants, 0);
+			if (ret)
+				goto out_put;
+			goto relock;
+		}
+		ret = agnocast_sub_reserve_held(sub, 1, true);
+		if (ret)
+			goto out_unlock;
+		/* Commit: older unreceived entries are passed over, not dropped. */
+		agnocast_entry_out(&arg.entry, entry);
+		arg.entry_count = 1;
+		agnocast_sub_take_newest(sub);
+	}
+	if (grants.count) {
+		agnocast_grants_commit(ctx.proc, &grants);
+		arg.pool = grants.out[0];
+		arg.pool_count = 1;
+	}
+	mutex_unlock(&topic->lock);
+	agnocast_leave(&ctx);
+	agnocast_answer_out(uarg, &arg, sizeof(arg));
+	ret = 0;
+	goto out_put;
+
+out_unlock:
+	mutex_unlock(&topic->lock);
+out_leave:
+	agnocast_leave(&ctx);
+out_close:
+	agnocast_grants_close(&grants);
+out_put:
+	agnocast_grants_put(&grants);
+	return ret;
+}
+
+int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	u64 ids_small[AGNOCAST_RELEASE_SMALL];
+	struct agnocast_release arg;
+	struct agnocast_endpoint *ep;
+	struct agnocast_ctx ctx;
+	u64 *ids;
+	int ret;
+
+	if (copy_from_user(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	if (arg.flags || !arg.count)
+		return -EINVAL;
+	ret = agnocast_release_ids_in(arg.entry_ids, arg.count, ids_small, &ids);
+	if (ret)
+		return ret;
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		goto out_free;
+	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	if (!ret) {
+		mutex_lock(&ep->topic->lock);
+		ret = agnocast_sub_release(agnocast_to_subscriber(ep), ids, arg.count);
+		mutex_unlock(&ep->topic->lock);
+	}
+	agnocast_leave(&ctx);
+out_free:
+	if (ids != ids_small)
+		kvfree(ids);
+	return ret;
+}
+
+int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_endpoint *pub, *sub;
+	struct agnocast_shed arg = {};
+	struct agnocast_ctx ctx;
+	int ret;
+
+	ret = agnocast_enter(&ctx, file_ns, true, false);
+	if (ret)
+		return ret;
+	list_for_each_entry(pub, &ctx.proc->publishers, proc_node) {
+		mutex_lock(&pub->topic->lock);
+		list_for_each_entry(sub, &pub->topic->subscribers, topic_node)
+			arg.shed += agnocast_sub_shed(agnocast_to_subscriber(sub),
+						      ctx.proc->pool);
+		mutex_unlock(&pub->topic->lock);
+	}
+	spin_lock(&ctx.proc->reclaim_lock);
+	arg.reclaimable = ctx.proc->nr_reclaim;
+	spin_unlock(&ctx.proc->reclaim_lock);
+	agnocast_leave(&ctx);
+	if (copy_to_user(uarg, &arg, sizeof(arg)))
+		return -EFAULT;
+	return 0;
+}

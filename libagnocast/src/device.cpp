@@ -145,7 +145,7 @@ std::string hex(std::uint64_t value) {
   return text;
 }
 
-[[noreturn]] void fail_add_endpoint(const Device& device, std::string_view command, int err,
+[[noreturn]] void fail_add_endpoint(Device& device, std::string_view command, int err,
                                     const EndpointRequest& request, std::string_view kind) {
   if (err == EPROTOTYPE) {
     std::string topic_type = "another type";
@@ -265,7 +265,7 @@ Device& Device::operator=(Device&& other) noexcept {
 
 Device::~Device() { close(); }
 
-void Device::close() {
+void Device::close() noexcept {
   if (fd_ >= 0) ::close(std::exchange(fd_, -1));
 }
 
@@ -303,7 +303,7 @@ void Device::unregister_process() const {
   }
 }
 
-EndpointId Device::add_publisher(const EndpointRequest& request) const {
+EndpointId Device::add_publisher(const EndpointRequest& request) {
   agnocast_add_endpoint argument = to_uapi(request);
   if (int err = call(fd_, AGNOCAST_IOC_ADD_PUBLISHER, &argument)) {
     fail_add_endpoint(*this, "ADD_PUBLISHER", err, request, "publisher");
@@ -311,7 +311,7 @@ EndpointId Device::add_publisher(const EndpointRequest& request) const {
   return EndpointId{argument.topic_handle, argument.id};
 }
 
-EndpointId Device::add_subscriber(const EndpointRequest& request) const {
+EndpointId Device::add_subscriber(const EndpointRequest& request) {
   agnocast_add_endpoint argument = to_uapi(request);
   if (int err = call(fd_, AGNOCAST_IOC_ADD_SUBSCRIBER, &argument)) {
     fail_add_endpoint(*this, "ADD_SUBSCRIBER", err, request, "subscriber");
@@ -319,14 +319,14 @@ EndpointId Device::add_subscriber(const EndpointRequest& request) const {
   return EndpointId{argument.topic_handle, argument.id};
 }
 
-void Device::remove_publisher(EndpointId endpoint) const {
+void Device::remove_publisher(EndpointId endpoint) {
   agnocast_remove_endpoint argument{endpoint.topic_handle, endpoint.id};
   if (int err = call(fd_, AGNOCAST_IOC_REMOVE_PUBLISHER, &argument)) {
     fail("REMOVE_PUBLISHER", err);
   }
 }
 
-void Device::remove_subscriber(EndpointId endpoint) const {
+void Device::remove_subscriber(EndpointId endpoint) {
   agnocast_remove_endpoint argument{endpoint.topic_handle, endpoint.id};
   if (int err = call(fd_, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &argument)) {
     fail("REMOVE_SUBSCRIBER", err);
@@ -334,8 +334,7 @@ void Device::remove_subscriber(EndpointId endpoint) const {
 }
 
 PublishResult Device::publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
-                              std::span<std::uint32_t> wake_ids,
-                              std::span<std::uint64_t> reclaim) const {
+                              std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim) {
   agnocast_publish argument{};
   argument.topic_handle = publisher.topic_handle;
   argument.publisher_id = publisher.id;
@@ -354,7 +353,7 @@ PublishResult Device::publish(EndpointId publisher, std::uint64_t addr, std::uin
                        argument.reclaim_pending};
 }
 
-ReclaimResult Device::reclaim(std::span<std::uint64_t> reclaim) const {
+ReclaimResult Device::reclaim(std::span<std::uint64_t> reclaim) {
   agnocast_reclaim argument{};
   argument.reclaim = reinterpret_cast<std::uintptr_t>(reclaim.data());
   argument.reclaim_capacity = static_cast<std::uint32_t>(reclaim.size());
@@ -363,7 +362,7 @@ ReclaimResult Device::reclaim(std::span<std::uint64_t> reclaim) const {
 }
 
 ReceiveResult Device::receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                              std::span<PoolGrant> pools) const {
+                              std::span<PoolGrant> pools) {
   // On the stack: this runs for every wake-up.
   std::array<agnocast_entry, receive_entries_max> raw_entries;
   std::array<agnocast_pool, receive_pools_max> raw_pools;
@@ -386,7 +385,7 @@ ReceiveResult Device::receive(EndpointId subscriber, std::span<ReceivedEntry> en
   return ReceiveResult{argument.entry_count, argument.pool_count, argument.remaining};
 }
 
-TakeResult Device::take(EndpointId subscriber) const {
+TakeResult Device::take(EndpointId subscriber) {
   agnocast_take argument{};
   argument.topic_handle = subscriber.topic_handle;
   argument.subscriber_id = subscriber.id;
@@ -403,7 +402,7 @@ TakeResult Device::take(EndpointId subscriber) const {
   return result;
 }
 
-void Device::release(EndpointId subscriber, std::uint64_t entry_id) const {
+void Device::release(EndpointId subscriber, std::uint64_t entry_id) {
   agnocast_release argument{};
   argument.topic_handle = subscriber.topic_handle;
   argument.subscriber_id = subscriber.id;
@@ -411,7 +410,7 @@ void Device::release(EndpointId subscriber, std::uint64_t entry_id) const {
   if (int err = call(fd_, AGNOCAST_IOC_RELEASE, &argument)) fail("RELEASE", err);
 }
 
-std::uint32_t Device::shed() const {
+std::uint32_t Device::shed() {
   agnocast_shed argument{};
   if (int err = call(fd_, AGNOCAST_IOC_SHED, &argument)) fail("SHED", err);
   return argument.shed;
@@ -525,8 +524,7 @@ std::vector<TopicSummary> Device::list_topics() const {
   std::vector<TopicSummary> topics;
   for (std::uint32_t i = 0; i < argument.total; ++i) {
     topics.push_back({bounded_string(raw[i].name, sizeof raw[i].name), raw[i].publishers,
-                      raw[i].subscribers,
-                      bounded_string(raw[i].type_name, sizeof raw[i].type_name),
+                      raw[i].subscribers, bounded_string(raw[i].type_name, sizeof raw[i].type_name),
                       raw[i].type_hash});
   }
   return topics;
@@ -546,7 +544,7 @@ std::optional<std::vector<std::uint8_t>> Device::topic_schema(const std::string&
   return schema;
 }
 
-bool Device::topic_info(const std::string& topic, TopicInfo& info) const {
+bool Device::topic_info(const std::string& topic, TopicInfo& info) {
   std::vector<agnocast_publisher_info> publishers(8);
   std::vector<agnocast_subscriber_info> subscribers(8);
   agnocast_topic_info argument{};
@@ -576,11 +574,10 @@ bool Device::topic_info(const std::string& topic, TopicInfo& info) const {
   info.schema_size = argument.schema_size;
   for (std::uint32_t i = 0; i < argument.publisher_total; ++i) {
     const auto& raw = publishers[i];
-    info.publishers.push_back(PublisherInfo{raw.id, raw.pid,
-                                            bounded_string(raw.node, sizeof raw.node), raw.depth,
-                                            (raw.flags & AGNOCAST_TRANSIENT_LOCAL) != 0,
-                                            raw.published, raw.published_bytes, raw.window,
-                                            raw.uid});
+    info.publishers.push_back(
+        PublisherInfo{raw.id, raw.pid, bounded_string(raw.node, sizeof raw.node), raw.depth,
+                      (raw.flags & AGNOCAST_TRANSIENT_LOCAL) != 0, raw.published,
+                      raw.published_bytes, raw.window, raw.uid});
   }
   for (std::uint32_t i = 0; i < argument.subscriber_total; ++i) {
     const auto& raw = subscribers[i];

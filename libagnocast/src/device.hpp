@@ -1,5 +1,6 @@
 // C++ wrapper over /dev/agnocast: one member per ioctl, errno turned into typed
-// exceptions. The only part of the library that knows the UAPI structures.
+// exceptions. The only part of the library that knows the UAPI structures; the
+// real Kernel behind the library's publishers and subscribers.
 #pragma once
 
 #include <sys/types.h>
@@ -16,10 +17,9 @@
 #include "agnocast/inspect.hpp"
 #include "agnocast/supervise.hpp"
 #include "agnocast/version.hpp"
+#include "kernel.hpp"
 
 namespace agnocast::detail {
-
-inline constexpr std::uint32_t depth_max = 1024;
 
 struct PoolSlot {
   pid_t pid = 0;
@@ -27,67 +27,11 @@ struct PoolSlot {
   std::uint64_t size = 0;
 };
 
-struct EndpointId {
-  std::uint32_t topic_handle = 0;
-  std::uint32_t id = 0;
-};
-
-struct EndpointRequest {
-  std::string topic;
-  std::string node;
-  std::uint32_t depth = 1;
-  bool transient_local = false;
-  bool polling = false;
-  // The message type: the topic's must be the same (TypeMismatch otherwise).
-  std::string type_name;
-  std::uint64_t type_hash = 0;
-  std::span<const std::uint8_t> schema;  // kept by the kernel for tools; may be empty
-};
-
-struct PublishResult {
-  std::uint64_t entry_id = 0;
-  std::uint32_t wake_count = 0;
-  std::uint32_t reclaim_count = 0;
-  std::uint32_t reclaim_pending = 0;
-};
-
-struct ReclaimResult {
-  std::uint32_t reclaim_count = 0;
-  std::uint32_t reclaim_pending = 0;
-};
-
-struct ReceivedEntry {
-  std::uint64_t entry_id = 0;
-  std::uint64_t addr = 0;
-  std::uint32_t publisher_id = 0;
-};
-
-// A read-only descriptor of a publisher's pool, owned by the receiver.
-struct PoolGrant {
-  std::uint64_t addr = 0;
-  std::uint64_t size = 0;
-  int fd = -1;
-  pid_t pid = 0;
-};
-
-struct ReceiveResult {
-  std::uint32_t entry_count = 0;
-  std::uint32_t pool_count = 0;
-  std::uint32_t remaining = 0;
-};
-
-struct TakeResult {
-  bool has_entry = false;
-  ReceivedEntry entry;
-  bool has_pool = false;
-  PoolGrant pool;
-};
-
 // Seals a pool memfd the way the module requires before it attaches it: after
 // this the mapping made before is the only way to write the pool.
 void seal_pool(int memfd);
 
-class Device {
+class Device final : public Kernel {
  public:
   // Opens /dev/agnocast O_CLOEXEC; read-write when permitted, else read-only
   // (enough for introspection). Throws ModuleNotLoaded when it is missing.
@@ -98,11 +42,11 @@ class Device {
   Device& operator=(Device&& other) noexcept;
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
-  ~Device();
+  ~Device() override;
 
   int fd() const { return fd_; }
   // Closes the descriptor (fork child reset); the object becomes empty.
-  void close();
+  void close() noexcept override;
   // Gives up ownership of the descriptor without closing it.
   int release() { return std::exchange(fd_, -1); }
 
@@ -111,24 +55,19 @@ class Device {
   PoolSlot register_process(int pool_fd) const;
   void unregister_process() const;
 
-  EndpointId add_publisher(const EndpointRequest& request) const;
-  EndpointId add_subscriber(const EndpointRequest& request) const;
-  void remove_publisher(EndpointId endpoint) const;
-  void remove_subscriber(EndpointId endpoint) const;
-
+  EndpointId add_publisher(const EndpointRequest& request) override;
+  EndpointId add_subscriber(const EndpointRequest& request) override;
+  void remove_publisher(EndpointId endpoint) override;
+  void remove_subscriber(EndpointId endpoint) override;
   PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
-                        std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim) const;
-  ReclaimResult reclaim(std::span<std::uint64_t> reclaim) const;
-  // The most entries and pool grants one receive() returns; larger spans are not filled further.
-  static constexpr std::size_t receive_entries_max = 32;
-  static constexpr std::size_t receive_pools_max = 8;
+                        std::span<std::uint32_t> wake_ids,
+                        std::span<std::uint64_t> reclaim) override;
+  ReclaimResult reclaim(std::span<std::uint64_t> reclaim) override;
+  std::uint32_t shed() override;
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
-                        std::span<PoolGrant> pools) const;
-  TakeResult take(EndpointId subscriber) const;
-  void release(EndpointId subscriber, std::uint64_t entry_id) const;
-  // Drops entries of this process's pool kept only for slow subscribers beyond
-  // the publisher's depth; returns how many. Reclaim afterwards.
-  std::uint32_t shed() const;
+                        std::span<PoolGrant> pools) override;
+  TakeResult take(EndpointId subscriber) override;
+  void release(EndpointId subscriber, std::uint64_t entry_id) override;
 
   // The IPC namespace's topic access policy; nullopt when none is in force.
   std::optional<AccessPolicy> get_policy() const;
@@ -140,7 +79,7 @@ class Device {
   // no such topic has an endpoint.
   std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic) const;
   // Returns false when no topic of that name has an endpoint.
-  bool topic_info(const std::string& topic, TopicInfo& info) const;
+  bool topic_info(const std::string& topic, TopicInfo& info) override;
   std::vector<ProcessInfo> list_processes() const;
 
   // Whole exit records waiting now (device opened non-blocking); empty if none.

@@ -182,8 +182,9 @@ void Executor::spin_some() {
 bool Executor::spin_once(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    // Rounded up: epoll_wait must not return before the deadline.
+    const auto left =
+        std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     const auto outcome =
         state_->wait_and_handle(static_cast<int>(std::max<std::int64_t>(left.count(), 0)));
     if (outcome == State::Outcome::handled) return true;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "agnocast/allocator.hpp"
+#include "fake_kernel.hpp"
 #include "runtime.hpp"
 
 namespace agnocast::detail {
@@ -112,7 +113,7 @@ class PoolTest : public ::testing::Test {
   static constexpr std::size_t pool_size = 16 << 20;
   void SetUp() override {
     region_ = new (std::align_val_t{4096}) std::byte[pool_size];
-    runtime_ = &Runtime::install_for_testing(region_, pool_size);
+    runtime_ = &Runtime::install_for_testing(region_, pool_size, std::make_unique<FakeKernel>());
     baseline_ = runtime_->pool_stats();
   }
   // The region is left to the leaked runtime: pointers into it may survive a test.

@@ -9,6 +9,7 @@
 #include <span>
 #include <stdexcept>
 
+#include "fake_kernel.hpp"
 #include "runtime.hpp"
 
 namespace render_test {
@@ -44,7 +45,8 @@ class MessageRender : public ::testing::Test {
   void SetUp() override {
     // Left to the leaked test runtime, like every test pool.
     region_ = new (std::align_val_t{4096}) std::byte[pool_size];
-    detail::Runtime::install_for_testing(region_, pool_size);
+    detail::Runtime::install_for_testing(region_, pool_size,
+                                         std::make_unique<detail::FakeKernel>());
     grid_.valid = true;
     grid_.scale = 0.25;
     grid_.origin = {-3, "a \"quoted\"\nline"};

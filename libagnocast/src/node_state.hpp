@@ -33,13 +33,3 @@ struct NodeState {
 };
 
 }  // namespace agnocast::detail
-
-namespace agnocast::detail {
-
-struct EndpointRequest;
-struct MessageType;
-// Validates topic and depth (std::invalid_argument naming the rule) and fills the request.
-EndpointRequest make_endpoint_request(const NodeState& node, std::string_view topic, const QoS& qos,
-                                      bool polling, const MessageType& type);
-
-}  // namespace agnocast::detail

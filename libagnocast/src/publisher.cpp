@@ -7,6 +7,7 @@
 
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
+#include "endpoint_request.hpp"
 #include "node_state.hpp"
 #include "notification_queue.hpp"
 #include "runtime.hpp"
@@ -22,7 +23,7 @@ struct PublisherCore::State {
       : node(std::move(node)),
         runtime(runtime),
         topic(request.topic),
-        endpoint(runtime.device().add_publisher(request)),
+        endpoint(runtime.kernel().add_publisher(request)),
         senders(request.topic) {}
 
   std::shared_ptr<NodeState> node;
@@ -37,7 +38,7 @@ struct PublisherCore::State {
 PublisherCore::PublisherCore(std::shared_ptr<NodeState> node, std::string_view topic,
                              const QoS& qos, const MessageType& type) {
   const EndpointRequest request =
-      make_endpoint_request(*node, topic, qos, /*polling=*/false, type);
+      make_endpoint_request(node->name, topic, qos, EndpointKind::publisher, type);
   state_ = std::make_unique<State>(std::move(node), Runtime::get(), request);
 }
 
@@ -45,7 +46,7 @@ PublisherCore::~PublisherCore() {
   // In a fork child the endpoint is the parent's: leave it alone.
   if (Runtime::current() != &state_->runtime) return;
   try {
-    state_->runtime.device().remove_publisher(state_->endpoint);
+    state_->runtime.kernel().remove_publisher(state_->endpoint);
     state_->runtime.reclaim_all();
   } catch (const Error&) {
     // Destructors cannot report; the kernel drops everything at process exit.
@@ -68,7 +69,7 @@ void PublisherCore::publish(void* message, std::size_t bytes) {
     std::lock_guard lock(state.mutex);
     for (;;) {
       try {
-        result = state.runtime.device().publish(state.endpoint,
+        result = state.runtime.kernel().publish(state.endpoint,
                                                 reinterpret_cast<std::uintptr_t>(message), bytes,
                                                 state.wake_ids, reclaimed);
         break;

@@ -15,6 +15,7 @@
 #include "agnocast/allocator.hpp"
 #include "agnocast/detail/message.hpp"
 #include "agnocast/errors.hpp"
+#include "device.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -53,8 +54,8 @@ void map_at(std::uint64_t addr, std::uint64_t size, int prot, int fd, bool repla
 
 }  // namespace
 
-Runtime::Runtime(std::optional<Device> device, pid_t pid, void* pool_addr, std::size_t pool_size)
-    : device_(std::move(device)),
+Runtime::Runtime(std::unique_ptr<Kernel> kernel, pid_t pid, void* pool_addr, std::size_t pool_size)
+    : kernel_(std::move(kernel)),
       pid_(pid),
       pool_addr_(pool_addr),
       pool_size_(pool_size),
@@ -116,12 +117,16 @@ Runtime* Runtime::create() {
     }
     throw;
   }
-  return new Runtime(std::move(device), slot.pid, reinterpret_cast<void*>(slot.addr), slot.size);
+  auto* runtime = new Runtime(std::make_unique<Device>(std::move(device)), slot.pid,
+                              reinterpret_cast<void*>(slot.addr), slot.size);
+  runtime->pool_mapped_here_ = true;
+  return runtime;
 }
 
-Runtime& Runtime::install_for_testing(void* region, std::size_t size) {
+Runtime& Runtime::install_for_testing(void* region, std::size_t size,
+                                      std::unique_ptr<Kernel> kernel) {
   std::lock_guard lock(init_mutex);
-  Runtime* runtime = new Runtime(std::nullopt, ::getpid(), region, size);
+  Runtime* runtime = new Runtime(std::move(kernel), ::getpid(), region, size);
   // Any earlier test runtime is leaked on purpose: pointers into it may survive.
   instance.store(runtime, std::memory_order_release);
   return *runtime;
@@ -133,12 +138,12 @@ Runtime& Runtime::install_for_testing(void* region, std::size_t size) {
 // that do not exist in the child.
 void Runtime::forget_in_fork_child() noexcept {
   Runtime* runtime = instance.exchange(nullptr);
-  if (!runtime || !runtime->device_) return;
+  if (!runtime || !runtime->pool_mapped_here_) return;
   ::munmap(runtime->pool_addr_, runtime->pool_size_);
   for (const auto& [addr, size] : runtime->mapped_pools_) {
     ::munmap(reinterpret_cast<void*>(addr), size);
   }
-  runtime->device_->close();
+  runtime->kernel_->close();
 }
 
 // On a full pool: first take back what nobody references any more, then
@@ -150,8 +155,8 @@ void* Runtime::allocate(std::size_t size, std::size_t align) {
       std::lock_guard lock(pool_mutex_);
       if (void* ptr = pool_.allocate(size, align)) return ptr;
     }
-    if (attempt == 2 || !device_) break;
-    if (attempt == 1) device_->shed();
+    if (attempt == 2) break;
+    if (attempt == 1) kernel_->shed();
     reclaim_all();
   }
   throw PoolExhausted(
@@ -186,7 +191,7 @@ void Runtime::free_reclaimed(std::span<const std::uint64_t> addresses) noexcept 
 void Runtime::reclaim_all() {
   std::vector<std::uint64_t> addresses(256);
   for (;;) {
-    const ReclaimResult result = device_->reclaim(addresses);
+    const ReclaimResult result = kernel_->reclaim(addresses);
     free_reclaimed(std::span(addresses.data(), result.reclaim_count));
     if (result.reclaim_pending == 0) break;
   }
@@ -218,63 +223,6 @@ std::span<const std::byte> Runtime::pool_holding(const void* address) {
   const auto& [addr, size] = *std::prev(after);
   if (at - addr >= size) return {};
   return {reinterpret_cast<const std::byte*>(addr), static_cast<std::size_t>(size)};
-}
-
-// The message functions of detail/message.hpp and allocator.hpp, over the runtime.
-
-namespace {
-thread_local std::uint64_t pool_bytes_allocated_by_this_thread = 0;
-}  // namespace
-
-void* pool_allocate(std::size_t bytes, std::size_t align) {
-  void* memory = Runtime::get().allocate(bytes, align);
-  pool_bytes_allocated_by_this_thread += bytes;
-  return memory;
-}
-
-void pool_deallocate(void* ptr) noexcept {
-  if (Runtime* runtime = Runtime::current()) runtime->deallocate(ptr);
-}
-
-namespace {
-
-constexpr std::size_t header_room = sizeof(MessageHeader);
-static_assert(header_room % alignof(MessageHeader) == 0);
-
-MessageHeader* header_of(void* message) {
-  return reinterpret_cast<MessageHeader*>(static_cast<char*>(message) - header_room);
-}
-
-}  // namespace
-
-void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*)) {
-  align = std::max(align, Tlsf::alignment);
-  const std::size_t offset = (header_room + align - 1) & ~(align - 1);  // keeps message aligned
-  void* block = Runtime::get().allocate(offset + size, align);
-  void* message = static_cast<char*>(block) + offset;
-  *header_of(message) = MessageHeader{destroy, block, &pool_bytes_allocated_by_this_thread,
-                                      pool_bytes_allocated_by_this_thread};
-  return message;
-}
-
-std::uint64_t published_bytes(void* message, std::size_t size) noexcept {
-  const MessageHeader& header = *header_of(message);
-  if (header.borrowing_thread_counter != &pool_bytes_allocated_by_this_thread) return size;
-  return size + (pool_bytes_allocated_by_this_thread - header.pool_bytes_at_borrow);
-}
-
-void free_message_memory(void* message) noexcept { pool_deallocate(header_of(message)->block); }
-
-void discard_message(void* message) noexcept {
-  const MessageHeader header = *header_of(message);
-  header.destroy(message);
-  pool_deallocate(header.block);
-}
-
-void release(EntryReference* reference) noexcept {
-  if (reference->count.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
-  reference->owner->release_entry(reference->entry_id);
-  delete reference;
 }
 
 }  // namespace agnocast::detail

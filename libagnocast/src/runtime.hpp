@@ -1,4 +1,4 @@
-// The process's agnocast state: the device, its registration, its own
+// The process's agnocast state: the kernel (the device, registered), its own
 // writable pool with the allocator over it, and the publisher pools it has
 // mapped read-only. Created lazily on first use, reset in a fork child.
 #pragma once
@@ -8,11 +8,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <mutex>
-#include <optional>
 #include <span>
 
-#include "device.hpp"
+#include "kernel.hpp"
 #include "tlsf.hpp"
 
 namespace agnocast::detail {
@@ -23,10 +23,11 @@ class Runtime {
   static Runtime& get();
   // The runtime if this process has one already, else nullptr; never initializes.
   static Runtime* current() noexcept;
-  // A runtime over a caller-provided region and no device, for native tests.
-  static Runtime& install_for_testing(void* region, std::size_t size);
+  // A runtime over a caller-provided region and kernel (a FakeKernel), for native tests.
+  static Runtime& install_for_testing(void* region, std::size_t size,
+                                      std::unique_ptr<Kernel> kernel);
 
-  const Device& device() const { return *device_; }
+  Kernel& kernel() const { return *kernel_; }
   pid_t pid() const { return pid_; }
 
   // Throws PoolExhausted after a reclaim round could not make room.
@@ -47,11 +48,13 @@ class Runtime {
   std::span<const std::byte> pool_holding(const void* address);
 
  private:
-  Runtime(std::optional<Device> device, pid_t pid, void* pool_addr, std::size_t pool_size);
+  Runtime(std::unique_ptr<Kernel> kernel, pid_t pid, void* pool_addr, std::size_t pool_size);
   static Runtime* create();
   static void forget_in_fork_child() noexcept;
 
-  std::optional<Device> device_;  // absent only in native tests
+  std::unique_ptr<Kernel> kernel_;
+  // False for a test runtime, whose region and kernel the test owns.
+  bool pool_mapped_here_ = false;
   pid_t pid_;
   void* pool_addr_;
   std::size_t pool_size_;
@@ -62,5 +65,9 @@ class Runtime {
   std::mutex mapped_mutex_;
   std::map<std::uint64_t, std::uint64_t> mapped_pools_;  // address -> size
 };
+
+// Pool bytes the calling thread has allocated so far, for the bandwidth
+// counter of the messages it publishes (see published_bytes()).
+const std::uint64_t& pool_bytes_allocated_by_this_thread() noexcept;
 
 }  // namespace agnocast::detail

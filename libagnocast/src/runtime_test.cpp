@@ -5,7 +5,10 @@
 #include <unistd.h>
 
 #include <cstddef>
+#include <memory>
 #include <new>
+
+#include "fake_kernel.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -24,7 +27,7 @@ PoolGrant publisher_pool() {
 
 TEST(PoolHolding, FindsTheOwnOrMappedPoolThatHoldsAnAddress) {
   auto* own = new (std::align_val_t{4096}) std::byte[pool_size];
-  Runtime& runtime = Runtime::install_for_testing(own, pool_size);
+  Runtime& runtime = Runtime::install_for_testing(own, pool_size, std::make_unique<FakeKernel>());
   const PoolGrant grant = publisher_pool();
   runtime.map_pool(grant);
   const auto* mapped = reinterpret_cast<const std::byte*>(grant.addr);

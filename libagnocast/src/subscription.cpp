@@ -6,6 +6,7 @@
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
+#include "endpoint_request.hpp"
 #include "node_state.hpp"
 #include "notification_queue.hpp"
 #include "runtime.hpp"
@@ -18,12 +19,12 @@ namespace {
 class SubscriberEndpoint : public EntryOwner {
  public:
   SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
-      : runtime_(runtime), id_(runtime.device().add_subscriber(request)) {}
+      : runtime_(runtime), id_(runtime.kernel().add_subscriber(request)) {}
 
   ~SubscriberEndpoint() override {
     if (!still_ours()) return;
     try {
-      runtime_.device().remove_subscriber(id_);
+      runtime_.kernel().remove_subscriber(id_);
     } catch (const Error&) {
       // Destructors cannot report; the kernel drops everything at process exit.
     }
@@ -32,7 +33,7 @@ class SubscriberEndpoint : public EntryOwner {
   void release_entry(std::uint64_t entry_id) noexcept override {
     if (!still_ours()) return;
     try {
-      runtime_.device().release(id_, entry_id);
+      runtime_.kernel().release(id_, entry_id);
     } catch (const Error&) {
       // As above: nothing useful to do with it here.
     }
@@ -86,7 +87,7 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
                                    const QoS& qos, const MessageType& type)
     : state_(std::make_unique<State>()) {
   const EndpointRequest request =
-      make_endpoint_request(*node, topic, qos, /*polling=*/false, type);
+      make_endpoint_request(node->name, topic, qos, EndpointKind::callback_subscriber, type);
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
@@ -114,8 +115,8 @@ std::size_t SubscriptionBase::handle_wakeup() {
   State& state = *state_;
   std::lock_guard lock(state.receive_mutex);
   Runtime& runtime = state.endpoint->runtime();
-  std::array<ReceivedEntry, Device::receive_entries_max> entries;
-  std::array<PoolGrant, Device::receive_pools_max> pools;
+  std::array<ReceivedEntry, Kernel::receive_entries_max> entries;
+  std::array<PoolGrant, Kernel::receive_pools_max> pools;
   std::size_t delivered = 0;
   // Receive before draining the queue, so a callback runs after one system
   // call.  The drain comes after, followed by one more receive unless it held
@@ -124,8 +125,8 @@ std::size_t SubscriptionBase::handle_wakeup() {
   // a later notification, so it always receives again).
   bool drained = false;
   for (;;) {
-    const ReceiveResult result = runtime.device().receive(state.endpoint->id(), entries, pools);
-    std::array<EntryReference*, Device::receive_entries_max> references;
+    const ReceiveResult result = runtime.kernel().receive(state.endpoint->id(), entries, pools);
+    std::array<EntryReference*, Kernel::receive_entries_max> references;
     for (std::uint32_t i = 0; i < result.entry_count; ++i) {
       references[i] = state.endpoint->reference_to(entries[i].entry_id, state.endpoint);
     }
@@ -159,7 +160,8 @@ struct PollingCore::State {
 PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
                          const MessageType& type)
     : state_(std::make_unique<State>()) {
-  const EndpointRequest request = make_endpoint_request(*node, topic, qos, /*polling=*/true, type);
+  const EndpointRequest request =
+      make_endpoint_request(node->name, topic, qos, EndpointKind::polling_subscriber, type);
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
@@ -172,7 +174,7 @@ std::uint32_t PollingCore::id() const { return state_->endpoint->id().id; }
 
 TakenEntry PollingCore::take() {
   SubscriberEndpoint& endpoint = *state_->endpoint;
-  const TakeResult taken = endpoint.runtime().device().take(endpoint.id());
+  const TakeResult taken = endpoint.runtime().kernel().take(endpoint.id());
   EntryReference* reference =
       taken.has_entry ? endpoint.reference_to(taken.entry.entry_id, state_->endpoint) : nullptr;
   if (taken.has_pool) {

@@ -1,0 +1,313 @@
+#include "fake_kernel.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+
+#include "agnocast/errors.hpp"
+
+namespace agnocast::detail {
+namespace {
+
+[[noreturn]] void fail(const char* command, int err) {
+  throw DeviceError(err, std::string("fake kernel: ") + command + " failed");
+}
+
+}  // namespace
+
+FakeKernel::FakeKernel() : caller_pid_(::getpid()) {}
+
+std::uint32_t FakeKernel::join(const EndpointRequest& request) {
+  for (const auto& [handle, topic] : topics_) {
+    if (topic.name != request.topic) continue;
+    if (topic.type_name != request.type_name || topic.type_hash != request.type_hash) {
+      throw TypeMismatch("fake kernel: topic " + request.topic + " carries " + topic.type_name);
+    }
+    return handle;
+  }
+  const std::uint32_t handle = next_handle_++;
+  Topic& topic = topics_[handle];
+  topic.name = request.topic;
+  topic.type_name = request.type_name;
+  topic.type_hash = request.type_hash;
+  return handle;
+}
+
+FakeKernel::Topic& FakeKernel::topic_of(EndpointId endpoint) {
+  const auto found = topics_.find(endpoint.topic_handle);
+  if (found == topics_.end()) fail("topic lookup", ENOENT);
+  return found->second;
+}
+
+FakeKernel::Subscriber& FakeKernel::subscriber_of(EndpointId endpoint) {
+  Topic& topic = topic_of(endpoint);
+  const auto found = topic.subscribers.find(endpoint.id);
+  if (found == topic.subscribers.end()) fail("subscriber lookup", ENOENT);
+  if (found->second.pid != caller_pid_) fail("subscriber lookup", EPERM);
+  return found->second;
+}
+
+EndpointId FakeKernel::add_publisher(const EndpointRequest& request) {
+  std::lock_guard lock(mutex_);
+  if (request.polling) fail("ADD_PUBLISHER", EINVAL);
+  const std::uint32_t handle = join(request);
+  Topic& topic = topics_[handle];
+  const std::uint32_t id = next_id_++;
+  Publisher& publisher = topic.publishers[id];
+  publisher.node = request.node;
+  publisher.pid = caller_pid_;
+  publisher.depth = request.depth;
+  publisher.transient_local = request.transient_local;
+  return EndpointId{handle, id};
+}
+
+EndpointId FakeKernel::add_subscriber(const EndpointRequest& request) {
+  std::lock_guard lock(mutex_);
+  const std::uint32_t handle = join(request);
+  Topic& topic = topics_[handle];
+  const std::uint32_t id = next_id_++;
+  Subscriber& subscriber = topic.subscribers[id];
+  subscriber.node = request.node;
+  subscriber.pid = caller_pid_;
+  subscriber.depth = request.depth;
+  subscriber.transient_local = request.transient_local;
+  subscriber.polling = request.polling;
+  if (request.transient_local) {
+    std::vector<std::uint64_t> kept;
+    for (const auto& [publisher_id, publisher] : topic.publishers) {
+      if (!publisher.transient_local) continue;
+      kept.insert(kept.end(), publisher.window.begin(), publisher.window.end());
+    }
+    std::sort(kept.begin(), kept.end());
+    const std::size_t skip = kept.size() > request.depth ? kept.size() - request.depth : 0;
+    for (std::size_t i = skip; i < kept.size(); ++i) {
+      subscriber.unreceived.push_back(kept[i]);
+      ++entries_[kept[i]].unreceived_by;
+    }
+  }
+  return EndpointId{handle, id};
+}
+
+void FakeKernel::remove_publisher(EndpointId endpoint) {
+  std::lock_guard lock(mutex_);
+  Topic& topic = topic_of(endpoint);
+  const auto found = topic.publishers.find(endpoint.id);
+  if (found == topic.publishers.end()) fail("REMOVE_PUBLISHER", ENOENT);
+  const std::deque<std::uint64_t> window = std::move(found->second.window);
+  topic.publishers.erase(found);
+  for (std::uint64_t entry_id : window) {
+    entries_[entry_id].in_window = false;
+    settle(entry_id);
+  }
+}
+
+void FakeKernel::remove_subscriber(EndpointId endpoint) {
+  std::lock_guard lock(mutex_);
+  Subscriber& subscriber = subscriber_of(endpoint);
+  const std::deque<std::uint64_t> unreceived = std::move(subscriber.unreceived);
+  const std::multiset<std::uint64_t> held = std::move(subscriber.held);
+  topic_of(endpoint).subscribers.erase(endpoint.id);
+  for (std::uint64_t entry_id : unreceived) {
+    --entries_[entry_id].unreceived_by;
+    settle(entry_id);
+  }
+  for (std::uint64_t entry_id : held) {
+    --entries_[entry_id].held_by;
+    settle(entry_id);
+  }
+}
+
+void FakeKernel::settle(std::uint64_t entry_id) {
+  const auto found = entries_.find(entry_id);
+  const Entry& entry = found->second;
+  if (entry.in_window || entry.unreceived_by > 0 || entry.held_by > 0) return;
+  reclaimable_[entry.pid].push_back(entry.addr);
+  entries_.erase(found);
+}
+
+void FakeKernel::drop_unreceived(Subscriber& subscriber, std::uint64_t entry_id) {
+  --entries_[entry_id].unreceived_by;
+  ++subscriber.dropped;
+  settle(entry_id);
+}
+
+PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, std::uint64_t bytes,
+                                  std::span<std::uint32_t> wake_ids,
+                                  std::span<std::uint64_t> reclaim) {
+  std::lock_guard lock(mutex_);
+  ++calls_.publish;
+  Topic& topic = topic_of(publisher_id);
+  const auto found = topic.publishers.find(publisher_id.id);
+  if (found == topic.publishers.end()) fail("PUBLISH", ENOENT);
+  Publisher& publisher = found->second;
+  if (wake_ids.size() < topic.subscribers.size()) fail("PUBLISH", ENOBUFS);
+
+  const std::uint64_t entry_id = next_entry_id_++;
+  entries_[entry_id] = Entry{addr, publisher_id.id, caller_pid_, true, 0, 0};
+  ++publisher.published;
+  publisher.published_bytes += bytes;
+  PublishResult result;
+  result.entry_id = entry_id;
+  for (auto& [id, subscriber] : topic.subscribers) {
+    subscriber.unreceived.push_back(entry_id);
+    ++entries_[entry_id].unreceived_by;
+    if (subscriber.unreceived.size() > subscriber.depth) {
+      const std::uint64_t oldest = subscriber.unreceived.front();
+      subscriber.unreceived.pop_front();
+      drop_unreceived(subscriber, oldest);
+    }
+    if (!subscriber.polling) wake_ids[result.wake_count++] = id;
+  }
+  publisher.window.push_back(entry_id);
+  if (publisher.window.size() > publisher.depth) {
+    const std::uint64_t oldest = publisher.window.front();
+    publisher.window.pop_front();
+    entries_[oldest].in_window = false;
+    settle(oldest);
+  }
+  std::deque<std::uint64_t>& freeable = reclaimable_[caller_pid_];
+  while (result.reclaim_count < reclaim.size() && !freeable.empty()) {
+    reclaim[result.reclaim_count++] = freeable.front();
+    freeable.pop_front();
+  }
+  result.reclaim_pending = static_cast<std::uint32_t>(freeable.size());
+  return result;
+}
+
+ReclaimResult FakeKernel::reclaim(std::span<std::uint64_t> reclaim) {
+  std::lock_guard lock(mutex_);
+  ++calls_.reclaim;
+  ReclaimResult result;
+  std::deque<std::uint64_t>& freeable = reclaimable_[caller_pid_];
+  while (result.reclaim_count < reclaim.size() && !freeable.empty()) {
+    reclaim[result.reclaim_count++] = freeable.front();
+    freeable.pop_front();
+  }
+  result.reclaim_pending = static_cast<std::uint32_t>(freeable.size());
+  return result;
+}
+
+std::uint32_t FakeKernel::shed() {
+  std::lock_guard lock(mutex_);
+  ++calls_.shed;
+  std::uint32_t shed = 0;
+  for (auto& [handle, topic] : topics_) {
+    for (auto& [id, subscriber] : topic.subscribers) {
+      std::deque<std::uint64_t> kept;
+      for (std::uint64_t entry_id : subscriber.unreceived) {
+        const Entry& entry = entries_[entry_id];
+        if (entry.pid == caller_pid_ && !entry.in_window) {
+          drop_unreceived(subscriber, entry_id);
+          ++shed;
+        } else {
+          kept.push_back(entry_id);
+        }
+      }
+      subscriber.unreceived = std::move(kept);
+    }
+  }
+  return shed;
+}
+
+ReceiveResult FakeKernel::receive(EndpointId subscriber_id, std::span<ReceivedEntry> entries,
+                                  std::span<PoolGrant> pools) {
+  std::lock_guard lock(mutex_);
+  ++calls_.receive;
+  if (entries.empty() || pools.empty()) fail("RECEIVE", EINVAL);
+  Subscriber& subscriber = subscriber_of(subscriber_id);
+  if (subscriber.polling) fail("RECEIVE", EINVAL);
+  ReceiveResult result;
+  const std::size_t capacity = std::min(entries.size(), receive_entries_max);
+  while (result.entry_count < capacity && !subscriber.unreceived.empty()) {
+    const std::uint64_t entry_id = subscriber.unreceived.front();
+    subscriber.unreceived.pop_front();
+    Entry& entry = entries_[entry_id];
+    --entry.unreceived_by;
+    ++entry.held_by;
+    subscriber.held.insert(entry_id);
+    ++subscriber.received;
+    entries[result.entry_count++] = ReceivedEntry{entry_id, entry.addr, entry.publisher_id};
+  }
+  result.remaining = static_cast<std::uint32_t>(subscriber.unreceived.size());
+  return result;
+}
+
+TakeResult FakeKernel::take(EndpointId subscriber_id) {
+  std::lock_guard lock(mutex_);
+  ++calls_.take;
+  Subscriber& subscriber = subscriber_of(subscriber_id);
+  if (!subscriber.polling) fail("TAKE", EINVAL);
+  TakeResult result;
+  if (subscriber.unreceived.empty()) return result;
+  const std::uint64_t newest = subscriber.unreceived.back();
+  subscriber.unreceived.pop_back();
+  while (!subscriber.unreceived.empty()) {
+    const std::uint64_t passed_over = subscriber.unreceived.front();
+    subscriber.unreceived.pop_front();
+    --entries_[passed_over].unreceived_by;
+    settle(passed_over);
+  }
+  Entry& entry = entries_[newest];
+  --entry.unreceived_by;
+  ++entry.held_by;
+  subscriber.held.insert(newest);
+  ++subscriber.received;
+  result.has_entry = true;
+  result.entry = ReceivedEntry{newest, entry.addr, entry.publisher_id};
+  return result;
+}
+
+void FakeKernel::release(EndpointId subscriber_id, std::uint64_t entry_id) {
+  std::lock_guard lock(mutex_);
+  ++calls_.release;
+  Subscriber& subscriber = subscriber_of(subscriber_id);
+  const auto held = subscriber.held.find(entry_id);
+  if (held == subscriber.held.end()) fail("RELEASE", ENOENT);
+  subscriber.held.erase(held);
+  --entries_[entry_id].held_by;
+  settle(entry_id);
+}
+
+bool FakeKernel::topic_info(const std::string& name, TopicInfo& info) {
+  std::lock_guard lock(mutex_);
+  for (const auto& [handle, topic] : topics_) {
+    if (topic.name != name || (topic.publishers.empty() && topic.subscribers.empty())) continue;
+    info = TopicInfo{};
+    info.name = name;
+    info.type_name = topic.type_name;
+    info.type_hash = topic.type_hash;
+    for (const auto& [id, publisher] : topic.publishers) {
+      info.publishers.push_back(
+          PublisherInfo{id, publisher.pid, publisher.node, publisher.depth,
+                        publisher.transient_local, publisher.published, publisher.published_bytes,
+                        static_cast<std::uint32_t>(publisher.window.size()), 0});
+    }
+    for (const auto& [id, subscriber] : topic.subscribers) {
+      info.subscribers.push_back(SubscriberInfo{
+          id, subscriber.pid, subscriber.node, subscriber.depth, subscriber.transient_local,
+          subscriber.polling, static_cast<std::uint32_t>(subscriber.unreceived.size()),
+          static_cast<std::uint32_t>(subscriber.held.size()), subscriber.received,
+          subscriber.dropped, 0});
+    }
+    return true;
+  }
+  return false;
+}
+
+FakeKernel::Calls FakeKernel::calls() const {
+  std::lock_guard lock(mutex_);
+  return calls_;
+}
+
+std::size_t FakeKernel::live_entries() const {
+  std::lock_guard lock(mutex_);
+  return entries_.size();
+}
+
+void FakeKernel::set_caller_pid(pid_t pid) {
+  std::lock_guard lock(mutex_);
+  caller_pid_ = pid;
+}
+
+}  // namespace agnocast::detail

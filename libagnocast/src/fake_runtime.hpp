@@ -1,0 +1,49 @@
+// A test runtime over a heap region with a FakeKernel, for native tests of
+// publishers, subscriptions and executors.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <string>
+
+#include "fake_kernel.hpp"
+#include "runtime.hpp"
+
+namespace agnocast::detail {
+
+// A message that records nothing but its sequence number.
+struct Counted {
+  std::uint64_t seq = 0;
+};
+
+class FakeRuntimeTest : public ::testing::Test {
+ protected:
+  static constexpr std::size_t pool_size = 4 << 20;
+
+  void SetUp() override {
+    auto kernel = std::make_unique<FakeKernel>();
+    kernel_ = kernel.get();
+    // Leaked with the runtime on purpose: pointers into it may survive a test.
+    void* region = new (std::align_val_t{4096}) std::byte[pool_size];
+    runtime_ = &Runtime::install_for_testing(region, pool_size, std::move(kernel));
+  }
+
+  // Unique among concurrently running test binaries: queues are system-wide.
+  std::string topic(const std::string& name) const {
+    return "/native_" + std::to_string(::getpid()) + "_" + name;
+  }
+
+  FakeKernel& kernel() { return *kernel_; }
+  Runtime& runtime() { return *runtime_; }
+
+ private:
+  FakeKernel* kernel_ = nullptr;
+  Runtime* runtime_ = nullptr;
+};
+
+}  // namespace agnocast::detail

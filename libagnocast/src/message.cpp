@@ -1,0 +1,54 @@
+// The message header placed before every loaned message (detail/message.hpp)
+// and the reference counting of received entries.
+#include "agnocast/detail/message.hpp"
+
+#include <algorithm>
+
+#include "agnocast/allocator.hpp"
+#include "runtime.hpp"
+#include "tlsf.hpp"
+
+namespace agnocast::detail {
+namespace {
+
+constexpr std::size_t header_room = sizeof(MessageHeader);
+static_assert(header_room % alignof(MessageHeader) == 0);
+
+MessageHeader* header_of(void* message) {
+  return reinterpret_cast<MessageHeader*>(static_cast<char*>(message) - header_room);
+}
+
+}  // namespace
+
+void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*)) {
+  align = std::max(align, Tlsf::alignment);
+  const std::size_t offset = (header_room + align - 1) & ~(align - 1);  // keeps message aligned
+  void* block = Runtime::get().allocate(offset + size, align);
+  void* message = static_cast<char*>(block) + offset;
+  const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
+  *header_of(message) = MessageHeader{destroy, block, &thread_counter, thread_counter};
+  return message;
+}
+
+std::uint64_t published_bytes(void* message, std::size_t size) noexcept {
+  const MessageHeader& header = *header_of(message);
+  const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
+  if (header.borrowing_thread_counter != &thread_counter) return size;
+  return size + (thread_counter - header.pool_bytes_at_borrow);
+}
+
+void free_message_memory(void* message) noexcept { pool_deallocate(header_of(message)->block); }
+
+void discard_message(void* message) noexcept {
+  const MessageHeader header = *header_of(message);
+  header.destroy(message);
+  pool_deallocate(header.block);
+}
+
+void release(EntryReference* reference) noexcept {
+  if (reference->count.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+  reference->owner->release_entry(reference->entry_id);
+  delete reference;
+}
+
+}  // namespace agnocast::detail

@@ -1,0 +1,119 @@
+#include "agnocast/subscription.hpp"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include "agnocast/node.hpp"
+#include "fake_runtime.hpp"
+
+namespace agnocast::detail {
+namespace {
+
+using SubscriptionTest = FakeRuntimeTest;
+
+void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
+  auto message = publisher.borrow_loaned_message();
+  message->seq = seq;
+  publisher.publish(std::move(message));
+}
+
+TEST_F(SubscriptionTest, OneWakeUpDeliversEveryWaitingMessageOldestFirst) {
+  Node node{"drain"};
+  const std::string name = topic("drain");
+  std::vector<std::uint64_t> seen;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{100}, [&](const ipc_shared_ptr<const Counted>& m) { seen.push_back(m->seq); });
+  auto publisher = node.create_publisher<Counted>(name, QoS{100});
+  for (std::uint64_t seq = 0; seq < 70; ++seq) publish(*publisher, seq);
+
+  EXPECT_EQ(subscription->handle_wakeup(), 70U);
+  ASSERT_EQ(seen.size(), 70U);
+  for (std::uint64_t seq = 0; seq < 70; ++seq) EXPECT_EQ(seen[seq], seq);
+  // 32 + 32 + 6 entries, then the drain found many notifications: one more, empty receive.
+  EXPECT_EQ(kernel().calls().receive, 4);
+  EXPECT_EQ(subscription->handle_wakeup(), 0U);
+}
+
+TEST_F(SubscriptionTest, ASingleNotificationCostsOneReceive) {
+  Node node{"single"};
+  const std::string name = topic("single");
+  int count = 0;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>&) { ++count; });
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  subscription->handle_wakeup();  // the subscription's own first notification
+  const int receives_before = kernel().calls().receive;
+
+  publish(*publisher, 1);
+  EXPECT_EQ(subscription->handle_wakeup(), 1U);
+  EXPECT_EQ(count, 1);
+  EXPECT_EQ(kernel().calls().receive - receives_before, 1);
+}
+
+TEST_F(SubscriptionTest, AMessageIsReleasedWhenItsLastPointerGoes) {
+  Node node{"hold"};
+  const std::string name = topic("hold");
+  std::vector<ipc_shared_ptr<const Counted>> kept;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>& m) { kept.push_back(m); });
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  publish(*publisher, 1);
+  publish(*publisher, 2);
+  subscription->handle_wakeup();
+  ASSERT_EQ(kept.size(), 2U);
+  // The first left the publisher's window but is held: it must stay.
+  EXPECT_EQ(kernel().live_entries(), 2U);
+  EXPECT_EQ(kept[0]->seq, 1U);
+  kept.erase(kept.begin());
+  EXPECT_EQ(kernel().calls().release, 1);
+  EXPECT_EQ(kernel().live_entries(), 1U);
+}
+
+TEST_F(SubscriptionTest, AThrowingCallbackReleasesTheRestOfItsBatchAndLosesNothingLater) {
+  Node node{"throw"};
+  const std::string name = topic("throw");
+  std::vector<std::uint64_t> seen;
+  auto subscription =
+      node.create_subscription<Counted>(name, QoS{10}, [&](const ipc_shared_ptr<const Counted>& m) {
+        seen.push_back(m->seq);
+        if (m->seq == 1) throw std::runtime_error("callback failed");
+      });
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  for (std::uint64_t seq = 0; seq < 4; ++seq) publish(*publisher, seq);
+
+  EXPECT_THROW(subscription->handle_wakeup(), std::runtime_error);
+  EXPECT_EQ(seen, (std::vector<std::uint64_t>{0, 1}));
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 0U) << "undelivered entries of the batch are released";
+
+  publish(*publisher, 4);
+  subscription->handle_wakeup();
+  EXPECT_EQ(seen.back(), 4U);
+}
+
+TEST_F(SubscriptionTest, ASubscriptionOutlivedByItsMessagesKeepsThemValid) {
+  Node node{"outlive"};
+  const std::string name = topic("outlive");
+  ipc_shared_ptr<const Counted> kept;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>& m) { kept = m; });
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  publish(*publisher, 7);
+  publish(*publisher, 8);
+  subscription->handle_wakeup();
+  subscription.reset();
+  EXPECT_EQ(kept->seq, 8U);
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.size(), 1U) << "the kernel subscriber stays while a message is held";
+  kept.reset();
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_TRUE(info.subscribers.empty());
+}
+
+}  // namespace
+}  // namespace agnocast::detail

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "allocation_counter.hpp"
 #include "bench_support.hpp"
 #include "syscall_counter.hpp"
 
@@ -217,9 +218,10 @@ const std::vector<std::string> counted_syscalls{
     "ioctl",        "epoll_wait",      "epoll_pwait", "mq_timedreceive",
     "mq_timedsend", "clock_nanosleep", "read",        "write"};
 
-// One side's window: counters and CPU time read at its start and end, and
-// reported as one vector: messages, CPU ns, then (when the kernel has the
-// counters) "total" and the counts in counted_syscalls order.
+// One side's window: counters, CPU time and heap allocations read at its
+// start and end, and reported as one vector: messages, CPU ns, allocations,
+// then (when the kernel has the counters) "total" and the counts in
+// counted_syscalls order.
 std::optional<SyscallCounter> open_counter() {
   std::string why;
   auto counter = SyscallCounter::open(counted_syscalls, &why);
@@ -231,16 +233,21 @@ struct Window {
   std::optional<SyscallCounter> counter = open_counter();
   SyscallCounts start_counts;
   std::int64_t start_cpu = 0;
+  std::uint64_t start_allocations = 0;
   std::vector<std::int64_t> report;
 
   void begin() {
+    start_allocations = allocations_by_this_thread();
     start_cpu = cpu_time_ns();
     if (counter) start_counts = counter->take_reading();
   }
   void end(std::size_t messages) {
     std::optional<SyscallCounts> between;
     if (counter) between = counted_between(start_counts, counter->take_reading());
-    report = {static_cast<std::int64_t>(messages), cpu_time_ns() - start_cpu};
+    const std::int64_t cpu_ns = cpu_time_ns() - start_cpu;
+    const auto allocations =
+        static_cast<std::int64_t>(allocations_by_this_thread() - start_allocations);
+    report = {static_cast<std::int64_t>(messages), cpu_ns, allocations};
     if (!between) return;
     report.push_back(between->at("total"));
     for (const auto& name : counted_syscalls) report.push_back(between->at(name));
@@ -248,10 +255,10 @@ struct Window {
 };
 
 std::optional<SyscallCounts> counts_per_message(const std::vector<std::int64_t>& report) {
-  if (report.size() != 3 + counted_syscalls.size()) return std::nullopt;
-  SyscallCounts counts{{"messages", report[0]}, {"total", report[2]}};
+  if (report.size() != 4 + counted_syscalls.size()) return std::nullopt;
+  SyscallCounts counts{{"messages", report[0]}, {"total", report[3]}};
   for (std::size_t i = 0; i < counted_syscalls.size(); ++i) {
-    counts[counted_syscalls[i]] = report[3 + i];
+    counts[counted_syscalls[i]] = report[4 + i];
   }
   return counts;
 }
@@ -329,7 +336,7 @@ SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size
   }
   reap(publisher, "publisher");
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
-  if (publisher_side.size() < 2 || subscriber_sides.front().size() < 2 ||
+  if (publisher_side.size() < 3 || subscriber_sides.front().size() < 3 ||
       subscriber_sides.front()[0] == 0) {
     throw std::runtime_error("a fixed-rate role measured nothing");
   }
@@ -338,6 +345,10 @@ SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size
       static_cast<double>(publisher_side[1]) / 1000.0 / static_cast<double>(publisher_side[0]);
   result.cpu.subscriber_us = static_cast<double>(subscriber_sides.front()[1]) / 1000.0 /
                              static_cast<double>(subscriber_sides.front()[0]);
+  result.publisher_allocations =
+      static_cast<double>(publisher_side[2]) / static_cast<double>(publisher_side[0]);
+  result.subscriber_allocations = static_cast<double>(subscriber_sides.front()[2]) /
+                                  static_cast<double>(subscriber_sides.front()[0]);
   result.publisher = counts_per_message(publisher_side);
   result.subscriber = counts_per_message(subscriber_sides.front());
   return result;

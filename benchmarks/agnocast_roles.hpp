@@ -41,6 +41,9 @@ struct SteadyResult {
   CpuPerMessage cpu;
   std::optional<SyscallCounts> publisher;  // empty when the kernel has no counters
   std::optional<SyscallCounts> subscriber;
+  // Heap allocations (operator new) per message on each side's thread.
+  double publisher_allocations = 0;
+  double subscriber_allocations = 0;
 };
 SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers);
 

@@ -1,11 +1,15 @@
 // agnocast-bench: every measurement of SPEC §9 in one run on one machine, so
 // the ratios between agnocast and its yardsticks hold even where absolute
 // times do not (the test VM runs under TCG emulation on a shared host).
+#include <poll.h>
 #include <sys/utsname.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -52,11 +56,62 @@ struct Plan {
 };
 
 // One short series of one round: which series it adds to and how it runs.
+// `extra` receives what a series measures besides latencies.
 struct Cell {
   std::string who;
   std::string label;
-  std::function<std::vector<std::int64_t>()> run;
+  std::function<std::vector<std::int64_t>(std::vector<std::int64_t>& extra)> run;
 };
+
+// Runs a cell in a child process of its own process group, so that a role
+// that hangs (a peer died while it waited) costs one cell of one round, not
+// the run: after `limit_s` the whole group is killed and the cell has no
+// samples.  False then.
+bool run_isolated(const Cell& cell, int limit_s, std::vector<std::int64_t>& samples,
+                  std::vector<std::int64_t>& extra) {
+  bench::Pipe results = bench::Pipe::open();
+  const pid_t child = fork();
+  if (child < 0) throw std::runtime_error("fork failed");
+  if (child == 0) {
+    setpgid(0, 0);
+    results.close_read();
+    int status = 1;
+    try {
+      std::vector<std::int64_t> more;
+      const std::vector<std::int64_t> measured = cell.run(more);
+      bench::send_latencies(results.write_fd, measured);
+      bench::send_latencies(results.write_fd, more);
+      status = 0;
+    } catch (const std::exception& error) {
+      std::cerr << "agnocast-bench: " << cell.who << " " << cell.label << ": " << error.what()
+                << "\n";
+    }
+    _exit(status);
+  }
+  setpgid(child, child);
+  results.close_write();
+  pollfd ready{results.read_fd, POLLIN, 0};
+  const bool answered = poll(&ready, 1, limit_s * 1000) == 1;
+  if (answered) {
+    samples = bench::receive_latencies(results.read_fd);
+    extra = bench::receive_latencies(results.read_fd);
+  } else {
+    kill(-child, SIGKILL);
+  }
+  results.close_read();
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  const bool ok = answered && WIFEXITED(status) && WEXITSTATUS(status) == 0 && !samples.empty();
+  if (!ok) {
+    kill(-child, SIGKILL);  // whatever of its group is left
+    std::cerr << "agnocast-bench: " << cell.who << " " << cell.label
+              << (answered ? " failed" : " timed out") << "; this round has none of it\n";
+    samples.clear();
+    extra.clear();
+  }
+  return ok;
+}
 
 // Samples of every series, kept per round so that ratios pair neighbours in time.
 class Samples {
@@ -190,57 +245,67 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
   const std::int64_t started_ns = bench::now_ns();
   Samples samples;
   std::vector<double> background_rates;
+  std::size_t failed_cells = 0;
+  constexpr int cell_limit_s = 180;
   std::mt19937_64 shuffle(plan.seed);
   const std::string small = bench::format_size(64), page = bench::format_size(4 << 10);
   for (std::size_t round = 0; round < plan.rounds; ++round) {
     std::vector<Cell> cells;
     const std::size_t n = plan.latency_samples;
-    cells.push_back({"mqueue_floor", "1 B",
-                     [&] { return bench::run_mqueue_floor(n, bench::FloorWait::blocking); }});
+    cells.push_back({"mqueue_floor", "1 B", [&](auto&) {
+                       return bench::run_mqueue_floor(n, bench::FloorWait::blocking);
+                     }});
     cells.push_back({"mqueue_epoll_floor", "1 B",
-                     [&] { return bench::run_mqueue_floor(n, bench::FloorWait::epoll); }});
+                     [&](auto&) { return bench::run_mqueue_floor(n, bench::FloorWait::epoll); }});
     for (std::size_t size : {std::size_t{64}, std::size_t{4} << 10}) {
-      cells.push_back({"agnocast", bench::format_size(size),
-                       [&, size] { return bench::run_agnocast_latency(size, n, 1).front(); }});
+      cells.push_back({"agnocast", bench::format_size(size), [&, size](auto&) {
+                         return bench::run_agnocast_latency(size, n, 1).front();
+                       }});
       if (iceoryx) {
         cells.push_back({"iceoryx", bench::format_size(size),
-                         [&, size] { return iceoryx->measure(size, n, 0); }});
+                         [&, size](auto&) { return iceoryx->measure(size, n, 0); }});
       }
     }
-    cells.push_back({"agnocast_beside_63_busy_topics", small, [&] {
-                       bench::BackgroundTraffic background(plan.background_topics,
-                                                           bench::steady_period_ns);
-                       auto latencies = bench::run_agnocast_latency(64, n, 1).front();
-                       background_rates.push_back(background.delivered_per_s());
-                       return latencies;
-                     }});
+    cells.push_back(
+        {"agnocast_beside_63_busy_topics", small, [&](std::vector<std::int64_t>& delivered_per_s) {
+           bench::BackgroundTraffic background(plan.background_topics, bench::steady_period_ns);
+           auto latencies = bench::run_agnocast_latency(64, n, 1).front();
+           delivered_per_s.push_back(static_cast<std::int64_t>(background.delivered_per_s()));
+           return latencies;
+         }});
     const std::size_t m = plan.constant_bytes_samples;
     for (std::size_t size : plan.sizes) {
       const std::size_t scratch = bench::constant_written_bytes - size;
       const std::string label = bench::format_size(size);
-      cells.push_back({"agnocast_constant_bytes", label,
-                       [=] { return bench::run_agnocast_latency(size, m, 1, scratch).front(); }});
+      cells.push_back({"agnocast_constant_bytes", label, [=](auto&) {
+                         return bench::run_agnocast_latency(size, m, 1, scratch).front();
+                       }});
       if (iceoryx) {
         cells.push_back({"iceoryx_constant_bytes", label,
-                         [&, size, scratch] { return iceoryx->measure(size, m, scratch); }});
+                         [&, size, scratch](auto&) { return iceoryx->measure(size, m, scratch); }});
       }
       cells.push_back({"unix_socket_constant_bytes", label,
-                       [=] { return bench::run_unix_socket_copy(size, m, scratch); }});
+                       [=](auto&) { return bench::run_unix_socket_copy(size, m, scratch); }});
     }
     for (std::size_t subscribers : plan.fanouts) {
       const std::string label = std::to_string(subscribers);
-      cells.push_back({"agnocast_fanout", label, [&, subscribers] {
+      cells.push_back({"agnocast_fanout", label, [&, subscribers](auto&) {
                          return last_delivery(bench::run_agnocast_latency(
                              4 << 10, plan.fanout_samples, subscribers));
                        }});
-      cells.push_back({"mqueue_fanout", label, [&, subscribers] {
+      cells.push_back({"mqueue_fanout", label, [&, subscribers](auto&) {
                          return bench::run_mqueue_fanout(subscribers, plan.fanout_samples);
                        }});
     }
     std::shuffle(cells.begin(), cells.end(), shuffle);
     std::cerr << "round " << round + 1 << " of " << plan.rounds << ": " << cells.size()
               << " series, " << (bench::now_ns() - started_ns) / 1'000'000'000 << " s so far\n";
-    for (const Cell& cell : cells) samples.add(round, cell.who, cell.label, cell.run());
+    for (const Cell& cell : cells) {
+      std::vector<std::int64_t> measured, extra;
+      if (!run_isolated(cell, cell_limit_s, measured, extra)) ++failed_cells;
+      samples.add(round, cell.who, cell.label, measured);
+      for (std::int64_t rate : extra) background_rates.push_back(static_cast<double>(rate));
+    }
   }
 
   // Series in a fixed order, sizes and subscriber counts ascending.
@@ -270,6 +335,7 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
     report["latency"]["iceoryx"] = nullptr;
     report["latency"]["iceoryx_constant_bytes"] = nullptr;
   }
+  report["failed_cells"] = failed_cells;
   report["background"] = {{"topics", plan.background_topics},
                           {"offered_per_s", plan.background_topics * 1e9 / bench::steady_period_ns},
                           {"delivered_per_s", bench::median(background_rates)}};
@@ -351,6 +417,8 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
   report["syscalls_per_message"] = {{"qos_10", syscalls_json(qos_10)},
                                     {"qos_1", syscalls_json(qos_1)},
                                     {"qos_10_4_subscribers", syscalls_json(qos_10_fanout_4)}};
+  report["allocations_per_message"] = {{"publisher", qos_10.publisher_allocations},
+                                       {"subscriber", qos_10.subscriber_allocations}};
   report["cpu_us_per_message"] = {
       {"agnocast", cpu_json(qos_10.cpu)},
       {"iceoryx", iceoryx ? cpu_json(iceoryx->cpu_per_message(plan.steady_messages)) : json()},

@@ -112,7 +112,7 @@ IceoryxRunner::~IceoryxRunner() {
 std::vector<std::int64_t> IceoryxRunner::measure(std::size_t size, std::size_t count,
                                                  std::size_t scratch_bytes) {
   constexpr std::size_t warmup = 3;
-  const std::string instance = std::to_string(++pairs_);
+  const std::string instance = std::to_string(getpid()) + "_" + std::to_string(++pairs_);
   Pipe ready = Pipe::open(), ack = Pipe::open(), results = Pipe::open();
   auto fd = [](int value) { return std::to_string(value); };
   const std::string size_text = std::to_string(size), count_text = std::to_string(count + warmup);
@@ -148,7 +148,7 @@ CpuPerMessage IceoryxRunner::cpu_per_message(std::size_t count) {
   Pipe ready = Pipe::open(), ack = Pipe::open(), results = Pipe::open();
   auto fd = [](int value) { return std::to_string(value); };
   const std::string count_text = std::to_string(count);
-  const std::string instance = std::to_string(++pairs_);
+  const std::string instance = std::to_string(getpid()) + "_" + std::to_string(++pairs_);
   pid_t subscriber =
       exec_child({role_program_, "sub", "--instance", instance, "--steady", "--count", count_text,
                   "--ready-fd", fd(ready.write_fd), "--ack-fd", fd(ack.write_fd), "--results-fd",

@@ -33,7 +33,7 @@ class IceoryxRunner {
       : role_program_(std::move(role_program)), roudi_pid_(roudi_pid) {}
   std::string role_program_;
   int roudi_pid_ = -1;
-  unsigned pairs_ = 0;  // role pairs started: each gets its own service instance
+  unsigned pairs_ = 0;  // role pairs this process started: with its pid, a unique instance
 };
 
 }  // namespace agnocast::bench

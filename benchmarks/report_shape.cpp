@@ -116,6 +116,10 @@ std::vector<std::string> report_shape_errors(const json& report) {
                  (!report["smoke"].get<bool>() && rounds->get<std::size_t>() < 20))) {
     check.errors.push_back("too few rounds for the intervals");
   }
+  const json* failed = check.at({"failed_cells"});
+  if (failed && (!failed->is_number_unsigned() || failed->get<std::size_t>() != 0)) {
+    check.errors.push_back("series failed or timed out in some rounds");
+  }
   check.latency("mqueue_floor", "1 B");
   check.latency("mqueue_epoll_floor", "1 B");
   for (const char* who : {"agnocast", "iceoryx"}) {
@@ -147,6 +151,12 @@ std::vector<std::string> report_shape_errors(const json& report) {
     check.syscalls(run, "subscriber", 1, {"ioctl"});
   }
   check.syscalls("qos_10_4_subscribers", "publisher", 5, {"ioctl", "mq_timedsend"});
+  for (const char* side : {"publisher", "subscriber"}) {
+    const json* allocations = check.at({"allocations_per_message", side});
+    if (allocations && (!allocations->is_number() || allocations->get<double>() < 0)) {
+      check.errors.push_back(std::string("allocations_per_message/") + side + " is not a count");
+    }
+  }
   for (const char* who : {"agnocast", "iceoryx", "mqueue_epoll_floor"}) {
     check.positive({"cpu_us_per_message", who, "publisher"});
     check.positive({"cpu_us_per_message", who, "subscriber"});
@@ -244,6 +254,14 @@ void print_markdown(const json& report) {
                 cpu.is_null() ? "—" : number(cpu["subscriber"], "%.1f").c_str());
   }
 
+  if (report.contains("allocations_per_message")) {
+    const json& allocations = report["allocations_per_message"];
+    std::printf(
+        "\nHeap allocations per message at 1 kHz (operator new, QoS 10): publisher %s, "
+        "subscriber %s.\n",
+        number(allocations["publisher"], "%.2f").c_str(),
+        number(allocations["subscriber"], "%.2f").c_str());
+  }
   const json& slopes = report["fanout_slope_us_per_subscriber"];
   std::printf("\nFan-out slope, µs per extra subscriber: agnocast %s, mqueue wake-ups %s.\n",
               number(slopes["agnocast"], "%.1f").c_str(), number(slopes["mqueue"], "%.1f").c_str());

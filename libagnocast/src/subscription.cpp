@@ -2,6 +2,7 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <vector>
 
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
@@ -19,9 +20,12 @@ namespace {
 class SubscriberEndpoint : public EntryOwner {
  public:
   SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
-      : runtime_(runtime), id_(runtime.kernel().add_subscriber(request)) {}
+      : runtime_(runtime), id_(runtime.kernel().add_subscriber(request)) {
+    spare_references_.reserve(spare_references_max);
+  }
 
   ~SubscriberEndpoint() override {
+    for (EntryReference* reference : spare_references_) delete reference;
     if (!still_ours()) return;
     try {
       runtime_.kernel().remove_subscriber(id_);
@@ -39,11 +43,33 @@ class SubscriberEndpoint : public EntryOwner {
     }
   }
 
+  // A spare reference when there is one, so that receiving allocates nothing
+  // once as many messages as a callback holds at a time have passed.
   EntryReference* reference_to(std::uint64_t entry_id, std::shared_ptr<EntryOwner> self) {
-    auto* reference = new EntryReference;
+    EntryReference* reference = nullptr;
+    {
+      std::lock_guard lock(spare_mutex_);
+      if (!spare_references_.empty()) {
+        reference = spare_references_.back();
+        spare_references_.pop_back();
+      }
+    }
+    if (!reference) reference = new EntryReference;
+    reference->count.store(1, std::memory_order_relaxed);
     reference->owner = std::move(self);
     reference->entry_id = entry_id;
     return reference;
+  }
+
+  void recycle(EntryReference* reference) noexcept override {
+    {
+      std::lock_guard lock(spare_mutex_);
+      if (spare_references_.size() < spare_references_max) {
+        spare_references_.push_back(reference);  // within the reserved capacity: no allocation
+        return;
+      }
+    }
+    delete reference;
   }
 
   Runtime& runtime() const { return runtime_; }
@@ -53,8 +79,13 @@ class SubscriberEndpoint : public EntryOwner {
   // False in a fork child: the endpoint and its references are the parent's.
   bool still_ours() const { return Runtime::current() == &runtime_; }
 
+  // As many as one receive delivers; more held at once are allocated and freed.
+  static constexpr std::size_t spare_references_max = Kernel::receive_entries_max;
+
   Runtime& runtime_;
   const EndpointId id_;
+  std::mutex spare_mutex_;  // releases come from any thread
+  std::vector<EntryReference*> spare_references_;
 };
 
 std::atomic<std::uint64_t> next_subscription_key{1};

@@ -1,0 +1,7 @@
+# find_package(agnocast_bridge): agnocast::bridge_core and agnocast_add_bridge().
+include(CMakeFindDependencyMacro)
+find_dependency(agnocast)
+find_dependency(CycloneDDS)
+find_dependency(nlohmann_json)
+include("${CMAKE_CURRENT_LIST_DIR}/agnocast_bridgeTargets.cmake")
+include("${CMAKE_CURRENT_LIST_DIR}/AgnocastBridge.cmake")

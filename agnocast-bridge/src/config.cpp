@@ -1,0 +1,157 @@
+#include "config.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include "agnocast/naming.hpp"
+#include "dds_names.hpp"
+
+namespace agnocast_bridge {
+namespace {
+
+using nlohmann::json;
+
+// DDS maps domain ids to UDP ports; 232 is the largest the default mapping allows.
+constexpr std::uint32_t max_domain_id = 232;
+// Bounded by what the kernel keeps per publisher and by memory for DDS histories.
+constexpr std::size_t max_depth = 65536;
+
+void refuse_unknown_keys(const json& object, const std::string& where,
+                         std::initializer_list<std::string_view> known) {
+  for (const auto& [key, value] : object.items()) {
+    bool is_known = false;
+    for (const auto name : known) is_known = is_known || key == name;
+    if (!is_known) {
+      throw ConfigError(where.empty() ? key : where + "." + key, "unknown key");
+    }
+  }
+}
+
+const json& require(const json& object, const std::string& where, const char* key) {
+  const auto found = object.find(key);
+  if (found == object.end()) throw ConfigError(where + "." + key, "missing");
+  return *found;
+}
+
+std::string require_string(const json& object, const std::string& where, const char* key) {
+  const json& value = require(object, where, key);
+  if (!value.is_string()) throw ConfigError(where + "." + key, "must be a string");
+  return value.get<std::string>();
+}
+
+bool optional_bool(const json& object, const std::string& where, const char* key, bool fallback) {
+  const auto found = object.find(key);
+  if (found == object.end()) return fallback;
+  if (!found->is_boolean()) throw ConfigError(where + "." + key, "must be true or false");
+  return found->get<bool>();
+}
+
+TopicQos parse_qos(const json& object, const std::string& where) {
+  if (!object.is_object()) throw ConfigError(where, "must be an object");
+  refuse_unknown_keys(object, where, {"depth", "reliable", "transient_local"});
+  TopicQos qos;
+  if (const auto depth = object.find("depth"); depth != object.end()) {
+    if (!depth->is_number_unsigned() || depth->get<std::uint64_t>() < 1 ||
+        depth->get<std::uint64_t>() > max_depth) {
+      throw ConfigError(where + ".depth",
+                        "must be an integer from 1 to " + std::to_string(max_depth));
+    }
+    qos.depth = depth->get<std::size_t>();
+  }
+  qos.reliable = optional_bool(object, where, "reliable", qos.reliable);
+  qos.transient_local = optional_bool(object, where, "transient_local", qos.transient_local);
+  return qos;
+}
+
+TopicConfig parse_topic(const json& object, const std::string& where) {
+  if (!object.is_object()) throw ConfigError(where, "must be an object");
+  refuse_unknown_keys(object, where, {"name", "type", "direction", "qos"});
+  TopicConfig topic;
+  topic.name = require_string(object, where, "name");
+  if (const std::string problem = agnocast::topic_name_problem(topic.name); !problem.empty()) {
+    throw ConfigError(where + ".name", problem);
+  }
+  topic.type = require_string(object, where, "type");
+  try {
+    dds_type_name(topic.type);
+  } catch (const std::invalid_argument& error) {
+    throw ConfigError(where + ".type", error.what());
+  }
+  const std::string direction = require_string(object, where, "direction");
+  if (direction == "to_dds") {
+    topic.direction = Direction::to_dds;
+  } else if (direction == "from_dds") {
+    topic.direction = Direction::from_dds;
+  } else {
+    throw ConfigError(where + ".direction",
+                      "must be \"to_dds\" or \"from_dds\", not \"" + direction + "\"");
+  }
+  if (const auto qos = object.find("qos"); qos != object.end()) {
+    topic.qos = parse_qos(*qos, where + ".qos");
+  }
+  return topic;
+}
+
+}  // namespace
+
+std::string_view direction_name(Direction direction) {
+  return direction == Direction::to_dds ? "to_dds" : "from_dds";
+}
+
+Config parse_config(std::string_view json_text) {
+  json document;
+  try {
+    document = json::parse(json_text);
+  } catch (const json::parse_error& error) {
+    throw ConfigError("", std::string("not valid JSON: ") + error.what());
+  }
+  if (!document.is_object()) throw ConfigError("", "the configuration must be a JSON object");
+  refuse_unknown_keys(document, "", {"domain_id", "topics"});
+
+  Config config;
+  if (const auto domain = document.find("domain_id"); domain != document.end()) {
+    if (!domain->is_number_unsigned() || domain->get<std::uint64_t>() > max_domain_id) {
+      throw ConfigError("domain_id",
+                        "must be an integer from 0 to " + std::to_string(max_domain_id));
+    }
+    config.domain_id = domain->get<std::uint32_t>();
+  }
+  const auto topics = document.find("topics");
+  if (topics == document.end()) throw ConfigError("topics", "missing");
+  if (!topics->is_array()) throw ConfigError("topics", "must be an array");
+  std::set<std::pair<std::string, Direction>> seen;
+  for (std::size_t i = 0; i < topics->size(); ++i) {
+    const std::string where = "topics[" + std::to_string(i) + "]";
+    TopicConfig topic = parse_topic((*topics)[i], where);
+    if (!seen.emplace(topic.name, topic.direction).second) {
+      throw ConfigError(where + ".name", "topic " + topic.name + " is already bridged " +
+                                             std::string(direction_name(topic.direction)));
+    }
+    config.topics.push_back(std::move(topic));
+  }
+  // A topic bridged both ways must have one type, as the topic itself has.
+  for (const auto& a : config.topics) {
+    for (std::size_t i = 0; i < config.topics.size(); ++i) {
+      const auto& b = config.topics[i];
+      if (a.name == b.name && a.type != b.type) {
+        throw ConfigError(
+            "topics[" + std::to_string(i) + "].type",
+            "topic " + b.name + " is bridged with two types, " + a.type + " and " + b.type);
+      }
+    }
+  }
+  return config;
+}
+
+Config load_config(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw ConfigError("", "cannot read " + path);
+  std::ostringstream text;
+  text << file.rdbuf();
+  return parse_config(text.str());
+}
+
+}  // namespace agnocast_bridge

@@ -1,0 +1,45 @@
+#include "status_file.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace agnocast_bridge {
+namespace {
+
+TEST(StatusFile, CountersPerTopicAsJson) {
+  TopicConfig points{"/points", "sensor_msgs/msg/PointCloud2", Direction::to_dds, {}};
+  TopicConfig cmd{"/cmd_vel", "geometry_msgs/msg/Twist", Direction::from_dds, {}};
+  BridgeStatus status{true, 42, 7, 1700000000, 5, {{&points, 10, 1, 2}, {&cmd, 3, 0, 0}}};
+
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("bridge-status-" + std::to_string(::getpid()));
+  const std::string path = (dir / "bridge.json").string();
+  write_status_file(path, status);
+  std::ifstream file(path);
+  const auto json = nlohmann::json::parse(file);
+  EXPECT_EQ(std::filesystem::status(path).permissions() & std::filesystem::perms::all,
+            std::filesystem::perms(0644));
+  std::filesystem::remove_all(dir);
+
+  EXPECT_EQ(json["running"], true);
+  EXPECT_EQ(json["pid"], 42);
+  EXPECT_EQ(json["domain_id"], 7);
+  ASSERT_EQ(json["topics"].size(), 2u);
+  const auto& first = json["topics"][0];
+  EXPECT_EQ(first["name"], "/points");
+  EXPECT_EQ(first["direction"], "to_dds");
+  EXPECT_EQ(first["dds_topic"], "rt/points");
+  EXPECT_EQ(first["dds_type"], "sensor_msgs::msg::dds_::PointCloud2_");
+  EXPECT_EQ(first["relayed"], 10);
+  EXPECT_EQ(first["dropped"], 1);
+  EXPECT_EQ(first["errors"], 2);
+  EXPECT_EQ(json["topics"][1]["direction"], "from_dds");
+  EXPECT_EQ(json["topics"][1]["relayed"], 3);
+}
+
+}  // namespace
+}  // namespace agnocast_bridge

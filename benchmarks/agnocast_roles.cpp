@@ -1,6 +1,7 @@
 #include "agnocast_roles.hpp"
 
 #include <sys/mman.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,8 +12,11 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
+#include "allocation_counter.hpp"
 #include "bench_support.hpp"
+#include "syscall_counter.hpp"
 
 namespace agnocast::bench {
 namespace {
@@ -119,12 +123,12 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
     agnocast::Node node{"bench_publisher"};
     auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{1});
     read_bytes(ready.read_fd, subscribers);
-    std::vector<std::uint8_t> scratch(scratch_bytes);
+    SharedScratch scratch(scratch_bytes);
     for (std::size_t seq = 0; seq < total; ++seq) {
       auto message = pub->borrow_loaned_message();
       message->payload.resize(size);
       fill_payload(std::span(message->payload.data(), size), seq);
-      fill_payload(scratch, seq);
+      fill_payload(scratch.bytes(), seq);
       message->seq = seq;
       delivered->store(0);
       message->t0_ns = now_ns();
@@ -204,6 +208,225 @@ Throughput run_agnocast_throughput(std::size_t size, std::size_t count) {
   double seconds = static_cast<double>(numbers[1] - numbers[0]) / 1e9;
   result.messages_per_s = seconds > 0 ? static_cast<double>(result.received) / seconds : 0;
   return result;
+}
+
+namespace {
+
+// What the counters break down: the calls of agnocast's paths and of the
+// benchmark's own pacing; "total" has every other call too.
+const std::vector<std::string> counted_syscalls{
+    "ioctl",        "epoll_wait",      "epoll_pwait", "mq_timedreceive",
+    "mq_timedsend", "clock_nanosleep", "read",        "write"};
+
+// One side's window: counters, CPU time and heap allocations read at its
+// start and end, and reported as one vector: messages, CPU ns, allocations,
+// then (when the kernel has the counters) "total" and the counts in
+// counted_syscalls order.
+std::optional<SyscallCounter> open_counter() {
+  std::string why;
+  auto counter = SyscallCounter::open(counted_syscalls, &why);
+  if (!counter) std::cerr << "agnocast-bench: system calls not counted: " << why << "\n";
+  return counter;
+}
+
+struct Window {
+  std::optional<SyscallCounter> counter = open_counter();
+  SyscallCounts start_counts;
+  std::int64_t start_cpu = 0;
+  std::uint64_t start_allocations = 0;
+  std::vector<std::int64_t> report;
+
+  void begin() {
+    start_allocations = allocations_by_this_thread();
+    start_cpu = cpu_time_ns();
+    if (counter) start_counts = counter->take_reading();
+  }
+  void end(std::size_t messages) {
+    std::optional<SyscallCounts> between;
+    if (counter) between = counted_between(start_counts, counter->take_reading());
+    const std::int64_t cpu_ns = cpu_time_ns() - start_cpu;
+    const auto allocations =
+        static_cast<std::int64_t>(allocations_by_this_thread() - start_allocations);
+    report = {static_cast<std::int64_t>(messages), cpu_ns, allocations};
+    if (!between) return;
+    report.push_back(between->at("total"));
+    for (const auto& name : counted_syscalls) report.push_back(between->at(name));
+  }
+};
+
+std::optional<SyscallCounts> counts_per_message(const std::vector<std::int64_t>& report) {
+  if (report.size() != 4 + counted_syscalls.size()) return std::nullopt;
+  SyscallCounts counts{{"messages", report[0]}, {"total", report[3]}};
+  for (std::size_t i = 0; i < counted_syscalls.size(); ++i) {
+    counts[counted_syscalls[i]] = report[4 + i];
+  }
+  return counts;
+}
+
+}  // namespace
+
+SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers) {
+  const std::string topic = next_topic("steady");
+  const std::size_t total = steady_warmup_messages + count + 1;
+  Pipe ready = Pipe::open(), publisher_report = Pipe::open();
+  std::vector<Pipe> reports;
+  std::vector<pid_t> subscriber_pids;
+  for (std::size_t s = 0; s < subscribers; ++s) {
+    reports.push_back(Pipe::open());
+    const int report_fd = reports.back().write_fd;
+    subscriber_pids.push_back(spawn([&, report_fd] {
+      agnocast::SingleThreadedExecutor executor;
+      agnocast::Node node{"bench_subscriber"};
+      Window window;
+      std::size_t in_window = 0;
+      bool counting = false;
+      // The callback makes no system call of its own between the two
+      // readings: what is counted is the executor's and the library's.  The
+      // window goes by sequence numbers, since a QoS 1 subscriber that falls
+      // behind loses messages; the newest one always arrives.
+      auto subscription = node.create_subscription<BenchMessage>(
+          topic, agnocast::QoS{depth}, [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
+            if (counting) ++in_window;
+            if (!counting && m->seq >= steady_warmup_messages &&
+                m->seq < steady_warmup_messages + count) {
+              counting = true;
+              window.begin();
+            } else if (counting && m->seq >= steady_warmup_messages + count) {
+              counting = false;
+              window.end(in_window);
+            }
+            if (m->seq + 1 == total) executor.cancel();
+          });
+      executor.add_node(node);
+      char byte = 1;
+      write_all(ready.write_fd, &byte, 1);
+      executor.spin();
+      send_latencies(report_fd, window.report);
+      return 0;
+    }));
+  }
+  pid_t publisher = spawn([&] {
+    agnocast::Node node{"bench_publisher"};
+    auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{depth});
+    read_bytes(ready.read_fd, subscribers);
+    Window window;
+    std::int64_t next = now_ns();
+    for (std::size_t seq = 0; seq < total; ++seq) {
+      next += steady_period_ns;
+      sleep_until_ns(next);
+      if (seq == steady_warmup_messages) window.begin();
+      auto message = pub->borrow_loaned_message();
+      message->payload.resize(64);
+      message->seq = seq;
+      message->t0_ns = now_ns();
+      pub->publish(std::move(message));
+      if (seq + 1 == steady_warmup_messages + count) window.end(count);
+    }
+    send_latencies(publisher_report.write_fd, window.report);
+    return 0;
+  });
+
+  publisher_report.close_write();
+  std::vector<std::int64_t> publisher_side = receive_latencies(publisher_report.read_fd);
+  std::vector<std::vector<std::int64_t>> subscriber_sides;
+  for (auto& pipe : reports) {
+    pipe.close_write();
+    subscriber_sides.push_back(receive_latencies(pipe.read_fd));
+    pipe.close_read();
+  }
+  reap(publisher, "publisher");
+  for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
+  if (publisher_side.size() < 3 || subscriber_sides.front().size() < 3 ||
+      subscriber_sides.front()[0] == 0) {
+    throw std::runtime_error("a fixed-rate role measured nothing");
+  }
+  SteadyResult result;
+  result.cpu.publisher_us =
+      static_cast<double>(publisher_side[1]) / 1000.0 / static_cast<double>(publisher_side[0]);
+  result.cpu.subscriber_us = static_cast<double>(subscriber_sides.front()[1]) / 1000.0 /
+                             static_cast<double>(subscriber_sides.front()[0]);
+  result.publisher_allocations =
+      static_cast<double>(publisher_side[2]) / static_cast<double>(publisher_side[0]);
+  result.subscriber_allocations = static_cast<double>(subscriber_sides.front()[2]) /
+                                  static_cast<double>(subscriber_sides.front()[0]);
+  result.publisher = counts_per_message(publisher_side);
+  result.subscriber = counts_per_message(subscriber_sides.front());
+  return result;
+}
+
+BackgroundTraffic::BackgroundTraffic(std::size_t topics, std::int64_t period_ns) {
+  void* memory =
+      mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (memory == MAP_FAILED) throw std::runtime_error("mmap failed");
+  shared_ = new (memory) Shared{};
+  std::vector<std::string> names;
+  for (std::size_t t = 0; t < topics; ++t) names.push_back(next_topic("background"));
+  Pipe ready = Pipe::open();
+  Shared* shared = shared_;
+  subscriber_ = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_background_subscriber"};
+    std::vector<std::shared_ptr<agnocast::Subscription<BenchMessage>>> subscriptions;
+    for (const auto& name : names) {
+      subscriptions.push_back(node.create_subscription<BenchMessage>(
+          name, agnocast::QoS{10},
+          [shared](const agnocast::ipc_shared_ptr<const BenchMessage>&) { ++shared->received; }));
+    }
+    executor.add_node(node);
+    std::thread stopper([&] {
+      while (!shared->stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      executor.cancel();
+    });
+    char byte = 1;
+    write_all(ready.write_fd, &byte, 1);
+    executor.spin();
+    stopper.join();
+    return 0;
+  });
+  publisher_ = spawn([&] {
+    agnocast::Node node{"bench_background_publisher"};
+    std::vector<std::shared_ptr<agnocast::Publisher<BenchMessage>>> publishers;
+    for (const auto& name : names) {
+      publishers.push_back(node.create_publisher<BenchMessage>(name, agnocast::QoS{10}));
+    }
+    char byte = 1;
+    write_all(ready.write_fd, &byte, 1);
+    // Every topic once a period; a period overrun is not caught up in a burst.
+    std::int64_t next = now_ns();
+    for (std::uint64_t seq = 0; !shared->stop.load(); ++seq) {
+      for (auto& pub : publishers) {
+        auto message = pub->borrow_loaned_message();
+        message->payload.resize(64);
+        message->seq = seq;
+        pub->publish(std::move(message));
+        ++shared->published;
+      }
+      next = std::max(next + period_ns, now_ns());
+      sleep_until_ns(next);
+    }
+    return 0;
+  });
+  read_bytes(ready.read_fd, 2);
+  // Let the traffic reach its pace before anything is measured beside it.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  started_ns_ = now_ns();
+  received_at_start_ = shared_->received.load();
+}
+
+BackgroundTraffic::~BackgroundTraffic() {
+  shared_->stop.store(true);
+  try {
+    reap(publisher_, "background publisher");
+    reap(subscriber_, "background subscriber");
+  } catch (const std::exception& error) {
+    std::cerr << error.what() << "\n";
+  }
+  munmap(shared_, sizeof(Shared));
+}
+
+double BackgroundTraffic::delivered_per_s() const {
+  const double seconds = static_cast<double>(now_ns() - started_ns_) / 1e9;
+  return static_cast<double>(shared_->received.load() - received_at_start_) / seconds;
 }
 
 }  // namespace agnocast::bench

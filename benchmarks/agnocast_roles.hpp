@@ -2,9 +2,16 @@
 // from the driver, which itself never touches agnocast.
 #pragma once
 
+#include <sys/types.h>
+
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
+
+#include "bench_support.hpp"
+#include "syscall_counter.hpp"
 
 namespace agnocast::bench {
 
@@ -25,5 +32,43 @@ struct Throughput {
 };
 // `count` small messages published back to back to one subscriber.
 Throughput run_agnocast_throughput(std::size_t size, std::size_t count);
+
+// One message a millisecond from one publisher to `subscribers`, both sides
+// with QoS depth `depth`: CPU time and counted system calls of each side over
+// `count` messages (the first subscriber's), in steady state.  The counts
+// are over "messages" messages (a QoS 1 subscriber may lose some).
+struct SteadyResult {
+  CpuPerMessage cpu;
+  std::optional<SyscallCounts> publisher;  // empty when the kernel has no counters
+  std::optional<SyscallCounts> subscriber;
+  // Heap allocations (operator new) per message on each side's thread.
+  double publisher_allocations = 0;
+  double subscriber_allocations = 0;
+};
+SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers);
+
+// `topics` other topics, each carrying one 64 B message every `period_ns`
+// from one publisher process to one subscriber process, while it lives.
+class BackgroundTraffic {
+ public:
+  BackgroundTraffic(std::size_t topics, std::int64_t period_ns);
+  ~BackgroundTraffic();
+  BackgroundTraffic(const BackgroundTraffic&) = delete;
+  BackgroundTraffic& operator=(const BackgroundTraffic&) = delete;
+  // Messages delivered per second, all topics together, since it started.
+  double delivered_per_s() const;
+
+ private:
+  struct Shared {
+    std::atomic<bool> stop{false};
+    std::atomic<std::uint64_t> published{0};
+    std::atomic<std::uint64_t> received{0};
+  };
+  Shared* shared_ = nullptr;
+  pid_t publisher_ = -1;
+  pid_t subscriber_ = -1;
+  std::int64_t started_ns_ = 0;
+  std::uint64_t received_at_start_ = 0;
+};
 
 }  // namespace agnocast::bench

@@ -2,11 +2,13 @@
 
 #include <fcntl.h>
 #include <mqueue.h>
+#include <sys/epoll.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <stdexcept>
@@ -17,16 +19,17 @@
 namespace agnocast::bench {
 namespace {
 
-constexpr const char* ping_queue = "/agnocast-bench-ping";
-constexpr const char* pong_queue = "/agnocast-bench-pong";
+std::string queue_name(const char* role, std::size_t index = 0) {
+  return "/agnocast-bench-" + std::to_string(getpid()) + "-" + role + "-" + std::to_string(index);
+}
 
-mqd_t open_queue(const char* name) {
+mqd_t open_queue(const std::string& name) {
   mq_attr attr{};
   attr.mq_maxmsg = 1;
   attr.mq_msgsize = 1;
-  mqd_t queue = mq_open(name, O_RDWR | O_CREAT, 0600, &attr);
+  mqd_t queue = mq_open(name.c_str(), O_RDWR | O_CREAT, 0600, &attr);
   if (queue == static_cast<mqd_t>(-1)) {
-    throw std::system_error(errno, std::generic_category(), std::string("mq_open ") + name);
+    throw std::system_error(errno, std::generic_category(), "mq_open " + name);
   }
   return queue;
 }
@@ -35,6 +38,45 @@ void wait_for(pid_t child) {
   int status = 0;
   while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
   }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    throw std::runtime_error("a baseline's receiver process failed");
+  }
+}
+
+// A receiver that sleeps the way `wait` says, then takes the message.
+class FloorReceiver {
+ public:
+  FloorReceiver(mqd_t queue, FloorWait wait) : queue_(queue) {
+    if (wait == FloorWait::blocking) return;
+    epoll_fd_ = epoll_create1(EPOLL_CLOEXEC);
+    epoll_event event{};
+    event.events = EPOLLIN;
+    if (epoll_fd_ < 0 || epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, queue, &event) != 0) {
+      throw std::system_error(errno, std::generic_category(), "epoll for the floor");
+    }
+  }
+  bool receive() const {
+    epoll_event event{};
+    if (epoll_fd_ >= 0) {
+      while (epoll_wait(epoll_fd_, &event, 1, -1) != 1) {
+        if (errno != EINTR) return false;
+      }
+    }
+    char byte = 0;
+    return mq_receive(queue_, &byte, 1, nullptr) == 1;
+  }
+
+ private:
+  mqd_t queue_;
+  int epoll_fd_ = -1;
+};
+
+template <typename T>
+T* map_shared(std::size_t count) {
+  void* memory =
+      mmap(nullptr, count * sizeof(T), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (memory == MAP_FAILED) throw std::system_error(errno, std::generic_category(), "mmap");
+  return static_cast<T*>(memory);
 }
 
 struct SocketFrame {
@@ -45,24 +87,20 @@ struct SocketFrame {
 
 }  // namespace
 
-std::vector<std::int64_t> run_mqueue_floor(std::size_t count) {
-  mq_unlink(ping_queue);
-  mq_unlink(pong_queue);
-  mqd_t ping = open_queue(ping_queue);
-  mqd_t pong = open_queue(pong_queue);
+std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait) {
+  const std::string ping_name = queue_name("ping"), pong_name = queue_name("pong");
+  mqd_t ping = open_queue(ping_name);
+  mqd_t pong = open_queue(pong_name);
   // One way, measured like agnocast's: from the send to the receiver's return
   // from mq_receive, on the shared monotonic clock.  Half the round trip
   // would average in the pong leg, whose sender is already awake.
-  const std::size_t arrivals_bytes = count * sizeof(std::int64_t);
-  void* shared =
-      mmap(nullptr, arrivals_bytes, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-  if (shared == MAP_FAILED) throw std::system_error(errno, std::generic_category(), "mmap");
-  auto* arrivals = static_cast<std::int64_t*>(shared);
+  auto* arrivals = map_shared<std::int64_t>(count);
   pid_t echo = fork();
   if (echo == 0) {
+    FloorReceiver receiver(ping, wait);
     char byte = 0;
     for (std::size_t i = 0; i < count; ++i) {
-      if (mq_receive(ping, &byte, 1, nullptr) != 1) _exit(1);
+      if (!receiver.receive()) _exit(1);
       arrivals[i] = now_ns();
       if (mq_send(pong, &byte, 1, 0) != 0) _exit(1);
     }
@@ -80,15 +118,71 @@ std::vector<std::int64_t> run_mqueue_floor(std::size_t count) {
     settle_between_messages();
   }
   wait_for(echo);
-  munmap(shared, arrivals_bytes);
+  munmap(arrivals, count * sizeof(std::int64_t));
   mq_close(ping);
   mq_close(pong);
-  mq_unlink(ping_queue);
-  mq_unlink(pong_queue);
+  mq_unlink(ping_name.c_str());
+  mq_unlink(pong_name.c_str());
   return one_way;
 }
 
-std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count) {
+std::vector<std::int64_t> run_mqueue_fanout(std::size_t receivers, std::size_t count) {
+  std::vector<std::string> names;
+  std::vector<mqd_t> queues;
+  for (std::size_t r = 0; r < receivers; ++r) {
+    names.push_back(queue_name("fanout", r));
+    queues.push_back(open_queue(names.back()));
+  }
+  auto* arrivals = map_shared<std::int64_t>(receivers);
+  auto* delivered = new (map_shared<std::atomic<std::uint32_t>>(1)) std::atomic<std::uint32_t>(0);
+  Pipe ack = Pipe::open();
+  std::vector<pid_t> children;
+  for (std::size_t r = 0; r < receivers; ++r) {
+    pid_t child = fork();
+    if (child == 0) {
+      FloorReceiver receiver(queues[r], FloorWait::epoll);
+      for (std::size_t i = 0; i < count; ++i) {
+        if (!receiver.receive()) _exit(1);
+        arrivals[r] = now_ns();
+        if (delivered->fetch_add(1) + 1 == receivers) {
+          char byte = 1;
+          write_all(ack.write_fd, &byte, 1);
+        }
+      }
+      _exit(0);
+    }
+    children.push_back(child);
+  }
+  std::vector<std::int64_t> last_delivery;
+  char byte = 1;
+  for (std::size_t i = 0; i < count; ++i) {
+    delivered->store(0);
+    const std::int64_t t0 = now_ns();
+    for (mqd_t queue : queues) {
+      if (mq_send(queue, &byte, 1, 0) != 0) {
+        throw std::system_error(errno, std::generic_category(), "mqueue fan-out");
+      }
+    }
+    if (!read_all(ack.read_fd, &byte, 1)) throw std::runtime_error("a fan-out receiver died");
+    std::int64_t last = 0;
+    for (std::size_t r = 0; r < receivers; ++r) last = std::max(last, arrivals[r]);
+    last_delivery.push_back(last - t0);
+    settle_between_messages();
+  }
+  for (pid_t child : children) wait_for(child);
+  for (std::size_t r = 0; r < receivers; ++r) {
+    mq_close(queues[r]);
+    mq_unlink(names[r].c_str());
+  }
+  munmap(arrivals, receivers * sizeof(std::int64_t));
+  munmap(delivered, sizeof(std::atomic<std::uint32_t>));
+  ack.close_read();
+  ack.close_write();
+  return last_delivery;
+}
+
+std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count,
+                                               std::size_t scratch_bytes) {
   int fds[2];
   if (socketpair(AF_UNIX, SOCK_STREAM, 0, fds) != 0) {
     throw std::system_error(errno, std::generic_category(), "socketpair");
@@ -114,9 +208,10 @@ std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t cou
   }
   close(fds[1]);
   results.close_write();
-  std::vector<std::uint8_t> payload(size);
+  std::vector<std::uint8_t> payload(size), scratch(scratch_bytes);
   for (std::size_t seq = 0; seq < count; ++seq) {
     fill_payload(payload, seq);
+    fill_payload(scratch, seq);
     SocketFrame frame{seq, now_ns(), size};
     write_all(fds[0], &frame, sizeof frame);
     write_all(fds[0], payload.data(), size);
@@ -132,6 +227,48 @@ std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t cou
     if (latency < 0) throw std::runtime_error("unix socket baseline: a payload arrived corrupted");
   }
   return latencies;
+}
+
+CpuPerMessage run_mqueue_floor_cpu(std::size_t count) {
+  const std::string name = queue_name("cpu");
+  mqd_t queue = open_queue(name);
+  Pipe ready = Pipe::open(), report = Pipe::open();
+  const std::size_t total = steady_warmup_messages + count;
+  pid_t child = fork();
+  if (child == 0) {
+    FloorReceiver receiver(queue, FloorWait::epoll);
+    char byte = 1;
+    write_all(ready.write_fd, &byte, 1);
+    std::int64_t cpu0 = 0;
+    for (std::size_t i = 0; i < total; ++i) {
+      if (!receiver.receive()) _exit(1);
+      if (i + 1 == steady_warmup_messages) cpu0 = cpu_time_ns();
+    }
+    const std::int64_t used = cpu_time_ns() - cpu0;
+    write_all(report.write_fd, &used, sizeof used);
+    _exit(0);
+  }
+  char byte = 1;
+  if (!read_all(ready.read_fd, &byte, 1)) throw std::runtime_error("floor receiver died");
+  std::int64_t cpu0 = 0;
+  std::int64_t next = now_ns();
+  for (std::size_t i = 0; i < total; ++i) {
+    next += steady_period_ns;
+    sleep_until_ns(next);
+    if (mq_send(queue, &byte, 1, 0) != 0) {
+      throw std::system_error(errno, std::generic_category(), "floor mq_send");
+    }
+    if (i + 1 == steady_warmup_messages) cpu0 = cpu_time_ns();
+  }
+  const std::int64_t publisher_used = cpu_time_ns() - cpu0;
+  std::int64_t subscriber_used = 0;
+  if (!read_all(report.read_fd, &subscriber_used, sizeof subscriber_used)) {
+    throw std::runtime_error("floor receiver died");
+  }
+  wait_for(child);
+  mq_close(queue);
+  mq_unlink(name.c_str());
+  return per_message(publisher_used, subscriber_used, count);
 }
 
 }  // namespace agnocast::bench

@@ -8,11 +8,27 @@
 
 namespace agnocast::bench {
 
-// One-way times (ns) of a 1-byte POSIX message queue ping-pong: send to
-// the receiver's return, the sender having just woken as a publisher has.
-std::vector<std::int64_t> run_mqueue_floor(std::size_t count);
+// How a floor's receiver sleeps: in mq_receive itself, or in epoll_wait on
+// the queue and then mq_receive, as agnocast's executor does.
+enum class FloorWait { blocking, epoll };
 
-// Send start to receive end (ns) of `size` bytes over a Unix stream socket.
-std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count);
+// One-way times (ns) of a 1-byte POSIX message queue ping-pong: send to
+// the receiver's return from mq_receive, the sender having just woken as a
+// publisher has.
+std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait);
+
+// Send of the first to the last receiver's return (ns): one process sends a
+// 1-byte message to each of `receivers` queues, each with its own receiver
+// process waiting in epoll.  The floor of agnocast's fan-out.
+std::vector<std::int64_t> run_mqueue_fanout(std::size_t receivers, std::size_t count);
+
+// Send start to receive end (ns) of `size` bytes over a Unix stream socket,
+// the sender writing `scratch_bytes` of private memory before each message.
+std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count,
+                                               std::size_t scratch_bytes);
+
+// User + system CPU of each side of the epoll floor per message, one
+// message a millisecond, over `count` messages after a warm-up.
+CpuPerMessage run_mqueue_floor_cpu(std::size_t count);
 
 }  // namespace agnocast::bench

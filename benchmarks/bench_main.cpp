@@ -1,22 +1,30 @@
 // agnocast-bench: every measurement of SPEC §9 in one run on one machine, so
 // the ratios between agnocast and its yardsticks hold even where absolute
-// times do not (the test VM runs under TCG emulation).
+// times do not (the test VM runs under TCG emulation on a shared host).
+#include <poll.h>
 #include <sys/utsname.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <random>
 
 #include "agnocast_roles.hpp"
 #include "baselines.hpp"
 #include "bench_support.hpp"
 #include "iceoryx_runner.hpp"
+#include "report_shape.hpp"
+#include "round_estimate.hpp"
 
 namespace bench = agnocast::bench;
 using json = nlohmann::ordered_json;
@@ -25,31 +33,116 @@ namespace {
 
 struct Plan {
   std::vector<std::size_t> sizes{64, 4 << 10, 1 << 20, 16 << 20, 64 << 20};
-  std::vector<std::size_t> iceoryx_sizes{64, 4 << 10, 1 << 20};
   std::vector<std::size_t> fanouts{1, 8, 64};
-  std::size_t fanout_size = 4 << 10;
-  std::size_t floor_count = 2000;
+  std::size_t rounds = 20;
+  std::size_t latency_samples = 9;         // per series and round
+  std::size_t constant_bytes_samples = 2;  // each writes 64 MiB first
+  std::size_t fanout_samples = 5;
+  std::size_t steady_messages = 1000;  // at 1 kHz
   std::size_t throughput_count = 20000;
-
-  std::size_t latency_count(std::size_t size) const {
-    if (smoke) return 3;
-    return size >= (16u << 20) ? 20 : 300;
-  }
-  std::size_t fanout_count() const { return smoke ? 3 : 100; }
-  std::size_t rounds = 3;  // latency and fan-out rounds; each takes a third of every series
+  std::size_t background_topics = 63;
+  std::uint64_t seed = 1;
   bool smoke = false;
-  std::vector<std::string> only;  // empty: every section
-
-  bool wants(const char* section) const {
-    return only.empty() || std::find(only.begin(), only.end(), section) != only.end();
-  }
 
   void make_smoke() {
     smoke = true;
-    rounds = 1;
-    floor_count = 20;
+    rounds = 2;
+    latency_samples = 2;
+    constant_bytes_samples = 1;
+    fanout_samples = 1;
+    steady_messages = 30;
     throughput_count = 200;
   }
+};
+
+// One short series of one round: which series it adds to and how it runs.
+// `extra` receives what a series measures besides latencies.
+struct Cell {
+  std::string who;
+  std::string label;
+  std::function<std::vector<std::int64_t>(std::vector<std::int64_t>& extra)> run;
+};
+
+// Runs a cell in a child process of its own process group, so that a role
+// that hangs (a peer died while it waited) costs one cell of one round, not
+// the run: after `limit_s` the whole group is killed and the cell has no
+// samples.  False then.
+bool run_isolated(const Cell& cell, int limit_s, std::vector<std::int64_t>& samples,
+                  std::vector<std::int64_t>& extra) {
+  bench::Pipe results = bench::Pipe::open();
+  const pid_t child = fork();
+  if (child < 0) throw std::runtime_error("fork failed");
+  if (child == 0) {
+    setpgid(0, 0);
+    results.close_read();
+    int status = 1;
+    try {
+      std::vector<std::int64_t> more;
+      const std::vector<std::int64_t> measured = cell.run(more);
+      bench::send_latencies(results.write_fd, measured);
+      bench::send_latencies(results.write_fd, more);
+      status = 0;
+    } catch (const std::exception& error) {
+      std::cerr << "agnocast-bench: " << cell.who << " " << cell.label << ": " << error.what()
+                << "\n";
+    }
+    _exit(status);
+  }
+  setpgid(child, child);
+  results.close_write();
+  pollfd ready{results.read_fd, POLLIN, 0};
+  const bool answered = poll(&ready, 1, limit_s * 1000) == 1;
+  if (answered) {
+    samples = bench::receive_latencies(results.read_fd);
+    extra = bench::receive_latencies(results.read_fd);
+  } else {
+    kill(-child, SIGKILL);
+  }
+  results.close_read();
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  const bool ok = answered && WIFEXITED(status) && WEXITSTATUS(status) == 0 && !samples.empty();
+  if (!ok) {
+    kill(-child, SIGKILL);  // whatever of its group is left
+    std::cerr << "agnocast-bench: " << cell.who << " " << cell.label
+              << (answered ? " failed" : " timed out") << "; this round has none of it\n";
+    samples.clear();
+    extra.clear();
+  }
+  return ok;
+}
+
+// Samples of every series, kept per round so that ratios pair neighbours in time.
+class Samples {
+ public:
+  void add(std::size_t round, const std::string& who, const std::string& label,
+           const std::vector<std::int64_t>& samples) {
+    auto& rounds = by_round_[{who, label}];
+    rounds.resize(std::max(rounds.size(), round + 1));
+    rounds[round].insert(rounds[round].end(), samples.begin(), samples.end());
+  }
+  bool has(const std::string& who, const std::string& label) const {
+    return by_round_.contains({who, label});
+  }
+  // p50 of that series in that round (µs); NaN when it has none.
+  double round_p50(std::size_t round, const std::string& who, const std::string& label) const {
+    auto found = by_round_.find({who, label});
+    if (found == by_round_.end() || round >= found->second.size() || found->second[round].empty()) {
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    return bench::summarize(found->second[round]).p50_us;
+  }
+  bench::LatencyStats pooled(const std::string& who, const std::string& label) const {
+    std::vector<std::int64_t> all;
+    for (const auto& round : by_round_.at({who, label})) {
+      all.insert(all.end(), round.begin(), round.end());
+    }
+    return bench::summarize(std::move(all));
+  }
+
+ private:
+  std::map<std::pair<std::string, std::string>, std::vector<std::vector<std::int64_t>>> by_round_;
 };
 
 json stats_json(const bench::LatencyStats& stats) {
@@ -67,6 +160,13 @@ std::vector<std::int64_t> last_delivery(
   return slowest;
 }
 
+std::string first_line_of(const char* path) {
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);
+  return line;
+}
+
 json machine_json() {
   utsname names{};
   uname(&names);
@@ -81,201 +181,304 @@ json machine_json() {
   return {{"kernel", names.release},
           {"cpu", cpu},
           {"cpus", sysconf(_SC_NPROCESSORS_ONLN)},
-          {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024}};
+          {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024},
+          {"system", first_line_of("/sys/devices/virtual/dmi/id/sys_vendor") + " " +
+                         first_line_of("/sys/devices/virtual/dmi/id/product_name")},
+          {"clocksource",
+           first_line_of("/sys/devices/system/clocksource/clocksource0/current_clocksource")}};
 }
 
-double ratio(double numerator, double denominator) {
-  return denominator > 0 ? numerator / denominator : 0;
+// A ratio measured in every round: numerator / denominator of that round's p50s.
+struct RoundRatio {
+  const char* name;
+  double target;
+  std::function<double(std::size_t round)> of_round;
+};
+
+// Per-message counts; `pacing` names the benchmark's own pacing call, left out.
+json counts_json(const bench::SyscallCounts& counts, const std::string& pacing) {
+  const double messages = static_cast<double>(counts.at("messages"));
+  std::int64_t named = 0;
+  json by_call = json::object();
+  for (const auto& [name, count] : counts) {
+    if (name == "messages" || name == "total" || name == pacing || count == 0) continue;
+    by_call[name] = static_cast<double>(count) / messages;
+    named += count;
+  }
+  const std::int64_t pacing_calls = counts.contains(pacing) ? counts.at(pacing) : 0;
+  const std::int64_t other = counts.at("total") - named - pacing_calls;
+  if (other != 0) by_call["other"] = static_cast<double>(other) / messages;
+  return {{"per_message", static_cast<double>(counts.at("total") - pacing_calls) / messages},
+          {"by_call", by_call},
+          {"messages", counts.at("messages")}};
+}
+
+json syscalls_json(const bench::SteadyResult& steady) {
+  if (!steady.publisher || !steady.subscriber) return nullptr;
+  // The publisher's clock_nanosleep is the benchmark's 1 kHz pacing, not agnocast's.
+  json publisher = counts_json(*steady.publisher, "clock_nanosleep");
+  json subscriber = counts_json(*steady.subscriber, "");
+  return {{"publisher", publisher["per_message"]},
+          {"subscriber", subscriber["per_message"]},
+          {"publisher_by_call", publisher["by_call"]},
+          {"subscriber_by_call", subscriber["by_call"]},
+          {"messages", subscriber["messages"]}};
+}
+
+json cpu_json(const bench::CpuPerMessage& cpu) {
+  return {{"publisher", cpu.publisher_us}, {"subscriber", cpu.subscriber_us}};
 }
 
 json run(const Plan& plan, const std::string& iceoryx_role) {
   json report;
   report["machine"] = machine_json();
   report["smoke"] = plan.smoke;
+  report["rounds"] = plan.rounds;
+  report["seed"] = plan.seed;
 
-  // Latency is measured in rounds, each taking its share of every series, so
-  // a slow spell of the emulator falls on all series alike instead of on
-  // whichever ran during it; the ratios compare neighbours in time.
-  std::map<std::string, std::map<std::string, std::vector<std::int64_t>>> samples;
-  std::vector<std::pair<std::string, std::string>> order;  // first-seen order of the series
-  auto add = [&](const std::string& who, const std::string& label, std::vector<std::int64_t> more) {
-    auto [series, inserted] = samples[who].try_emplace(label);
-    if (inserted) order.emplace_back(who, label);
-    series->second.insert(series->second.end(), more.begin(), more.end());
-  };
-  auto share = [&](std::size_t count) { return (count + plan.rounds - 1) / plan.rounds; };
+  std::optional<bench::IceoryxRunner> iceoryx = bench::IceoryxRunner::start(iceoryx_role);
+  if (!iceoryx) std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
 
-  std::optional<bench::IceoryxRunner> iceoryx =
-      plan.wants("iceoryx") ? bench::IceoryxRunner::start(iceoryx_role) : std::nullopt;
-  if (plan.wants("iceoryx") && !iceoryx) {
-    std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
-  }
-  const bool latency_wanted = plan.wants("floor") || plan.wants("latency") || iceoryx;
-  for (std::size_t round = 1; round <= plan.rounds && latency_wanted; ++round) {
-    std::cerr << "latency round " << round << " of " << plan.rounds << "...\n";
-    if (plan.wants("floor")) {
-      add("mqueue_floor", "1 B", bench::run_mqueue_floor(share(plan.floor_count)));
+  // Every round runs every series briefly, in its own shuffled order, so a
+  // slow spell of the emulator or of the host falls on a few series of one
+  // round, and each ratio pairs two series measured close together.
+  const std::int64_t started_ns = bench::now_ns();
+  Samples samples;
+  std::vector<double> background_rates;
+  std::size_t failed_cells = 0;
+  constexpr int cell_limit_s = 180;
+  std::mt19937_64 shuffle(plan.seed);
+  const std::string small = bench::format_size(64), page = bench::format_size(4 << 10);
+  for (std::size_t round = 0; round < plan.rounds; ++round) {
+    std::vector<Cell> cells;
+    const std::size_t n = plan.latency_samples;
+    cells.push_back({"mqueue_floor", "1 B", [&](auto&) {
+                       return bench::run_mqueue_floor(n, bench::FloorWait::blocking);
+                     }});
+    cells.push_back({"mqueue_epoll_floor", "1 B",
+                     [&](auto&) { return bench::run_mqueue_floor(n, bench::FloorWait::epoll); }});
+    for (std::size_t size : {std::size_t{64}, std::size_t{4} << 10}) {
+      cells.push_back({"agnocast", bench::format_size(size), [&, size](auto&) {
+                         return bench::run_agnocast_latency(size, n, 1).front();
+                       }});
+      if (iceoryx) {
+        cells.push_back({"iceoryx", bench::format_size(size),
+                         [&, size](auto&) { return iceoryx->measure(size, n, 0); }});
+      }
     }
+    cells.push_back(
+        {"agnocast_beside_63_busy_topics", small, [&](std::vector<std::int64_t>& delivered_per_s) {
+           bench::BackgroundTraffic background(plan.background_topics, bench::steady_period_ns);
+           auto latencies = bench::run_agnocast_latency(64, n, 1).front();
+           delivered_per_s.push_back(static_cast<std::int64_t>(background.delivered_per_s()));
+           return latencies;
+         }});
+    const std::size_t m = plan.constant_bytes_samples;
     for (std::size_t size : plan.sizes) {
-      if (!plan.wants("latency")) break;
+      const std::size_t scratch = bench::constant_written_bytes - size;
       const std::string label = bench::format_size(size);
-      const std::size_t count = share(plan.latency_count(size));
-      add("agnocast", label, bench::run_agnocast_latency(size, count, 1).front());
-      if (plan.wants("copy")) add("unix_socket", label, bench::run_unix_socket_copy(size, count));
+      cells.push_back({"agnocast_constant_bytes", label, [=](auto&) {
+                         return bench::run_agnocast_latency(size, m, 1, scratch).front();
+                       }});
+      if (iceoryx) {
+        cells.push_back({"iceoryx_constant_bytes", label,
+                         [&, size, scratch](auto&) { return iceoryx->measure(size, m, scratch); }});
+      }
+      cells.push_back({"unix_socket_constant_bytes", label,
+                       [=](auto&) { return bench::run_unix_socket_copy(size, m, scratch); }});
     }
-    if (plan.wants("latency")) {
-      // The same 64 B message after writing 64 MiB elsewhere: how much of the
-      // growth with size is the caches the large write evicted.
-      add("agnocast_after_64_mib_write", "64 B",
-          bench::run_agnocast_latency(64, share(plan.latency_count(64 << 20)), 1, 64 << 20)
-              .front());
-    }
-    for (std::size_t size : plan.iceoryx_sizes) {
-      if (!iceoryx) break;
-      add("iceoryx", bench::format_size(size),
-          iceoryx->measure(size, share(plan.latency_count(size))));
-    }
-  }
-  for (const auto& [who, label] : order) {
-    report["latency"][who][label] = stats_json(bench::summarize(samples[who][label]));
-  }
-  if (!iceoryx) report["latency"]["iceoryx"] = nullptr;
-
-  if (plan.wants("throughput")) {
-    std::cerr << "throughput...\n";
-    auto throughput = bench::run_agnocast_throughput(64, plan.throughput_count);
-    report["throughput"] = {{"size_bytes", 64},
-                            {"published", throughput.published},
-                            {"received", throughput.received},
-                            {"messages_per_s", throughput.messages_per_s}};
-  }
-
-  // Fan-out in rounds too, for the same reason as latency.
-  std::map<std::size_t, std::vector<std::int64_t>> fanout_samples;
-  for (std::size_t round = 1; round <= plan.rounds && plan.wants("fanout"); ++round) {
     for (std::size_t subscribers : plan.fanouts) {
-      std::cerr << "fan-out to " << subscribers << " subscribers, round " << round << "...\n";
-      auto slowest = last_delivery(
-          bench::run_agnocast_latency(plan.fanout_size, share(plan.fanout_count()), subscribers));
-      auto& series = fanout_samples[subscribers];
-      series.insert(series.end(), slowest.begin(), slowest.end());
+      const std::string label = std::to_string(subscribers);
+      cells.push_back({"agnocast_fanout", label, [&, subscribers](auto&) {
+                         return last_delivery(bench::run_agnocast_latency(
+                             4 << 10, plan.fanout_samples, subscribers));
+                       }});
+      cells.push_back({"mqueue_fanout", label, [&, subscribers](auto&) {
+                         return bench::run_mqueue_fanout(subscribers, plan.fanout_samples);
+                       }});
+    }
+    std::shuffle(cells.begin(), cells.end(), shuffle);
+    std::cerr << "round " << round + 1 << " of " << plan.rounds << ": " << cells.size()
+              << " series, " << (bench::now_ns() - started_ns) / 1'000'000'000 << " s so far\n";
+    for (const Cell& cell : cells) {
+      std::vector<std::int64_t> measured, extra;
+      if (!run_isolated(cell, cell_limit_s, measured, extra)) ++failed_cells;
+      samples.add(round, cell.who, cell.label, measured);
+      for (std::int64_t rate : extra) background_rates.push_back(static_cast<double>(rate));
     }
   }
-  for (std::size_t subscribers : plan.fanouts) {
-    if (!fanout_samples.contains(subscribers)) continue;
-    report["fanout"][std::to_string(subscribers)] =
-        stats_json(bench::summarize(fanout_samples[subscribers]));
-  }
 
-  auto p50 = [&](const char* who, const char* size) -> double {
-    if (!report.contains("latency") || !report["latency"].contains(who)) return 0;
-    const json& entry = report["latency"][who];
-    if (entry.is_null() || !entry.contains(size)) return 0;
-    return entry[size]["p50_us"].get<double>();
+  // Series in a fixed order, sizes and subscriber counts ascending.
+  std::vector<std::string> size_labels, fanout_labels;
+  for (std::size_t size : plan.sizes) size_labels.push_back(bench::format_size(size));
+  for (std::size_t subscribers : plan.fanouts) fanout_labels.push_back(std::to_string(subscribers));
+  const std::vector<std::pair<std::string, std::vector<std::string>>> series{
+      {"mqueue_floor", {"1 B"}},
+      {"mqueue_epoll_floor", {"1 B"}},
+      {"agnocast", {small, page}},
+      {"iceoryx", {small, page}},
+      {"agnocast_beside_63_busy_topics", {small}},
+      {"agnocast_constant_bytes", size_labels},
+      {"iceoryx_constant_bytes", size_labels},
+      {"unix_socket_constant_bytes", size_labels},
+      {"agnocast_fanout", fanout_labels},
+      {"mqueue_fanout", fanout_labels},
   };
-  auto fanout_p50 = [&](const char* n) -> double {
-    if (!report.contains("fanout") || !report["fanout"].contains(n)) return 0;
-    return report["fanout"][n]["p50_us"].get<double>();
+  for (const auto& [who, labels] : series) {
+    for (const auto& label : labels) {
+      if (samples.has(who, label)) {
+        report["latency"][who][label] = stats_json(samples.pooled(who, label));
+      }
+    }
+  }
+  if (!iceoryx) {
+    report["latency"]["iceoryx"] = nullptr;
+    report["latency"]["iceoryx_constant_bytes"] = nullptr;
+  }
+  report["failed_cells"] = failed_cells;
+  report["background"] = {{"topics", plan.background_topics},
+                          {"offered_per_s", plan.background_topics * 1e9 / bench::steady_period_ns},
+                          {"delivered_per_s", bench::median(background_rates)}};
+
+  auto p50 = [&](std::size_t round, const char* who, const std::string& label) {
+    return samples.round_p50(round, who, label);
   };
-  report["ratios"] = {
-      {"size_flatness", ratio(p50("agnocast", "64 MiB"), p50("agnocast", "64 B"))},
-      // The same, against a 64 B message sent after an equally large write.
-      {"size_flatness_cache_controlled",
-       ratio(p50("agnocast", "64 MiB"), p50("agnocast_after_64_mib_write", "64 B"))},
-      {"vs_iceoryx", ratio(p50("agnocast", "4 KiB"), p50("iceoryx", "4 KiB"))},
-      {"vs_mqueue_floor", ratio(p50("agnocast", "64 B"), p50("mqueue_floor", "1 B"))},
-      {"fanout_64", ratio(fanout_p50("64"), fanout_p50("1"))},
+  const std::string largest = bench::format_size(plan.sizes.back());
+  const std::string smallest = bench::format_size(plan.sizes.front());
+  auto slope = [&](std::size_t round, const char* who) {
+    const double first = static_cast<double>(plan.fanouts.front());
+    const double last = static_cast<double>(plan.fanouts.back());
+    return (p50(round, who, std::to_string(plan.fanouts.back())) -
+            p50(round, who, std::to_string(plan.fanouts.front()))) /
+           (last - first);
   };
-  report["targets"] = {{"size_flatness", 1.05},
-                       {"size_flatness_cache_controlled", 1.05},
-                       {"vs_iceoryx", 1.0},
-                       {"vs_mqueue_floor", 1.3},
-                       {"fanout_64", 64.0}};
+  const std::vector<RoundRatio> ratios{
+      {"size_flatness", 1.05,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_constant_bytes", largest) /
+                p50(r, "agnocast_constant_bytes", smallest);
+       }},
+      {"size_flatness_iceoryx", 1.05,
+       [&](std::size_t r) {
+         return p50(r, "iceoryx_constant_bytes", largest) /
+                p50(r, "iceoryx_constant_bytes", smallest);
+       }},
+      {"vs_iceoryx", 1.0,
+       [&](std::size_t r) { return p50(r, "agnocast", page) / p50(r, "iceoryx", page); }},
+      {"vs_mqueue_floor", 1.3,
+       [&](std::size_t r) { return p50(r, "agnocast", small) / p50(r, "mqueue_floor", "1 B"); }},
+      {"vs_epoll_floor", 1.3,
+       [&](std::size_t r) {
+         return p50(r, "agnocast", small) / p50(r, "mqueue_epoll_floor", "1 B");
+       }},
+      {"topics_64", 1.2,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_beside_63_busy_topics", small) / p50(r, "agnocast", small);
+       }},
+      {"fanout_slope", 1.2,
+       [&](std::size_t r) { return slope(r, "agnocast_fanout") / slope(r, "mqueue_fanout"); }},
+      {"fanout_64", 64.0,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_fanout", std::to_string(plan.fanouts.back())) /
+                p50(r, "agnocast_fanout", std::to_string(plan.fanouts.front()));
+       }},
+  };
+  for (const RoundRatio& ratio : ratios) {
+    std::vector<double> per_round;
+    for (std::size_t round = 0; round < plan.rounds; ++round) {
+      per_round.push_back(ratio.of_round(round));
+    }
+    const bench::RoundEstimate estimate = bench::estimate_over_rounds(per_round);
+    if (estimate.rounds == 0) {
+      report["ratios"][ratio.name] = nullptr;
+      report["ratio_ci"][ratio.name] = nullptr;
+      report["met"][ratio.name] = nullptr;
+    } else {
+      report["ratios"][ratio.name] = estimate.value;
+      report["ratio_ci"][ratio.name] = {estimate.low, estimate.high};
+      report["met"][ratio.name] = estimate.high <= ratio.target;
+    }
+    report["targets"][ratio.name] = ratio.target;
+    report["ratio_rounds"][ratio.name] = estimate.rounds;
+  }
+  std::vector<double> agnocast_slopes, mqueue_slopes;
+  for (std::size_t round = 0; round < plan.rounds; ++round) {
+    agnocast_slopes.push_back(slope(round, "agnocast_fanout"));
+    mqueue_slopes.push_back(slope(round, "mqueue_fanout"));
+  }
+  report["fanout_slope_us_per_subscriber"] = {{"agnocast", bench::median(agnocast_slopes)},
+                                              {"mqueue", bench::median(mqueue_slopes)}};
+
+  std::cerr << "system calls and CPU time at 1 kHz...\n";
+  const bench::SteadyResult qos_10 = bench::run_agnocast_steady(10, plan.steady_messages, 1);
+  const bench::SteadyResult qos_1 = bench::run_agnocast_steady(1, plan.steady_messages, 1);
+  const bench::SteadyResult qos_10_fanout_4 =
+      bench::run_agnocast_steady(10, plan.steady_messages, 4);
+  report["syscalls_per_message"] = {{"qos_10", syscalls_json(qos_10)},
+                                    {"qos_1", syscalls_json(qos_1)},
+                                    {"qos_10_4_subscribers", syscalls_json(qos_10_fanout_4)}};
+  report["allocations_per_message"] = {{"publisher", qos_10.publisher_allocations},
+                                       {"subscriber", qos_10.subscriber_allocations}};
+  report["cpu_us_per_message"] = {
+      {"agnocast", cpu_json(qos_10.cpu)},
+      {"iceoryx", iceoryx ? cpu_json(iceoryx->cpu_per_message(plan.steady_messages)) : json()},
+      {"mqueue_epoll_floor", cpu_json(bench::run_mqueue_floor_cpu(plan.steady_messages))}};
+
+  std::cerr << "throughput...\n";
+  auto throughput = bench::run_agnocast_throughput(64, plan.throughput_count);
+  report["throughput"] = {{"size_bytes", 64},
+                          {"published", throughput.published},
+                          {"received", throughput.received},
+                          {"messages_per_s", throughput.messages_per_s}};
   return report;
-}
-
-void print_table(const json& report) {
-  std::printf("machine: %s, %lld CPUs, kernel %s\n",
-              report["machine"]["cpu"].get<std::string>().c_str(),
-              report["machine"]["cpus"].get<long long>(),
-              report["machine"]["kernel"].get<std::string>().c_str());
-  std::printf("\none-way latency, microseconds (p50 / p99)\n");
-  std::printf("%-10s %-22s %-22s %-22s\n", "payload", "agnocast", "unix socket (copy)", "iceoryx");
-  const json none = json::object();
-  const json& latency = report.contains("latency") ? report["latency"] : none;
-  const json& agnocast_latency = latency.contains("agnocast") ? latency["agnocast"] : none;
-  for (const auto& [label, agnocast] : agnocast_latency.items()) {
-    auto cell = [&](const json& entry) {
-      if (entry.is_null() || !entry.contains(label)) return std::string("-");
-      char text[64];
-      std::snprintf(text, sizeof text, "%.1f / %.1f", entry[label]["p50_us"].get<double>(),
-                    entry[label]["p99_us"].get<double>());
-      return std::string(text);
-    };
-    auto column = [&](const char* who) {
-      return cell(latency.contains(who) ? latency[who] : none);
-    };
-    std::printf("%-10s %-22s %-22s %-22s\n", label.c_str(), column("agnocast").c_str(),
-                column("unix_socket").c_str(), column("iceoryx").c_str());
-  }
-  if (latency.contains("agnocast_after_64_mib_write")) {
-    const json& control = latency["agnocast_after_64_mib_write"]["64 B"];
-    std::printf("agnocast 64 B after a 64 MiB write (cache control): %.1f / %.1f\n",
-                control["p50_us"].get<double>(), control["p99_us"].get<double>());
-  }
-  if (latency.contains("mqueue_floor")) {
-    const json& floor = latency["mqueue_floor"]["1 B"];
-    std::printf("mqueue notification floor (1 B): %.1f / %.1f\n", floor["p50_us"].get<double>(),
-                floor["p99_us"].get<double>());
-  }
-  if (report.contains("throughput")) {
-    std::printf("\nthroughput (64 B): %.0f messages/s (%llu of %llu received)\n",
-                report["throughput"]["messages_per_s"].get<double>(),
-                report["throughput"]["received"].get<unsigned long long>(),
-                report["throughput"]["published"].get<unsigned long long>());
-  }
-  std::printf("\npublish to last delivery, 4 KiB, microseconds (p50 / p99)\n");
-  for (const auto& [subscribers, stats] :
-       (report.contains("fanout") ? report["fanout"] : none).items()) {
-    std::printf("%3s subscriber(s): %.1f / %.1f\n", subscribers.c_str(),
-                stats["p50_us"].get<double>(), stats["p99_us"].get<double>());
-  }
-  std::printf("\nratio                            measured   target (lower is better)\n");
-  for (const auto& [name, value] : report["ratios"].items()) {
-    std::printf("%-32s %8.3f   %6.2f\n", name.c_str(), value.get<double>(),
-                report["targets"][name].get<double>());
-  }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"agnocast-bench: latency, throughput and fan-out against iceoryx and baselines"};
+  CLI::App app{
+      "agnocast-bench: latency, fan-out, system calls and CPU time against iceoryx and "
+      "baselines"};
   bool json_output = false, smoke = false;
   std::string iceoryx_role =
       (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "agnocast-bench-iceoryx")
           .string();
-  app.add_flag("--json", json_output, "print one JSON object instead of tables");
-  app.add_flag("--smoke", smoke, "tiny counts: checks that every measurement works");
-  app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
   Plan plan;
-  std::vector<std::string> size_texts;
-  app.add_option("--only", plan.only, "run only these sections (default: all)")
-      ->check(CLI::IsMember({"floor", "latency", "copy", "iceoryx", "throughput", "fanout"}));
-  app.add_option("--sizes", size_texts, "payload sizes for the latency sections, e.g. 64 4K 1M");
+  app.add_flag("--json", json_output, "print one JSON object instead of Markdown tables");
+  app.add_flag("--smoke", smoke,
+               "tiny counts, then check the report's shape: every measurement works");
+  app.add_option("--rounds", plan.rounds, "rounds (at least 20 for the report's intervals)")
+      ->check(CLI::Range(2, 1000));
+  app.add_option("--seed", plan.seed, "seed of the rounds' shuffled order");
+  app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
+  std::string render;
+  app.add_option("--render", render,
+                 "measure nothing: print a saved --json report as Markdown tables");
   CLI11_PARSE(app, argc, argv);
 
-  if (smoke) plan.make_smoke();
-  if (!size_texts.empty()) {
-    plan.sizes.clear();
-    for (const auto& text : size_texts) plan.sizes.push_back(bench::parse_size(text));
+  if (!render.empty()) {
+    std::ifstream saved(render);
+    try {
+      bench::print_markdown(json::parse(saved));
+    } catch (const std::exception& error) {
+      std::cerr << "agnocast-bench: " << render << ": " << error.what() << "\n";
+      return 1;
+    }
+    return 0;
   }
+
+  if (smoke) plan.make_smoke();
   try {
     json report = run(plan, iceoryx_role);
     if (json_output) {
       std::cout << report.dump() << "\n";
     } else {
-      print_table(report);
+      bench::print_markdown(report);
+    }
+    if (smoke) {
+      const std::vector<std::string> errors = bench::report_shape_errors(report);
+      for (const auto& error : errors) std::cerr << "agnocast-bench: report: " << error << "\n";
+      if (!errors.empty()) return 1;
     }
   } catch (const std::exception& error) {
     std::cerr << "agnocast-bench: " << error.what() << "\n";

@@ -18,6 +18,44 @@ std::int64_t now_ns();
 // sample then measures a wake-up from sleep, not the tail of the last message.
 void settle_between_messages();
 
+// Sleeps until a CLOCK_MONOTONIC time: fixed-rate loops pace with it.
+void sleep_until_ns(std::int64_t deadline_ns);
+
+// User + system CPU time this process has used, in nanoseconds.
+std::int64_t cpu_time_ns();
+
+// Bytes written before each sample besides the payload, so that every payload
+// size is preceded by the same number of written bytes (SPEC §9: payload +
+// scratch = 64 MiB).  Shared memory (a memfd), the kind the zero-copy
+// transports' payloads live in.
+class SharedScratch {
+ public:
+  explicit SharedScratch(std::size_t bytes);
+  ~SharedScratch();
+  SharedScratch(const SharedScratch&) = delete;
+  SharedScratch& operator=(const SharedScratch&) = delete;
+  std::span<std::uint8_t> bytes() { return {data_, size_}; }
+
+ private:
+  std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+// Fixed-rate runs (CPU time and system calls per message): one message a
+// millisecond; the first few are not counted.
+constexpr std::int64_t steady_period_ns = 1'000'000;
+constexpr std::size_t steady_warmup_messages = 5;
+
+struct CpuPerMessage {
+  double publisher_us = 0;
+  double subscriber_us = 0;
+};
+CpuPerMessage per_message(std::int64_t publisher_ns, std::int64_t subscriber_ns,
+                          std::size_t messages);
+
+// Every sample of the size series writes this many bytes in all.
+constexpr std::size_t constant_written_bytes = std::size_t{64} << 20;
+
 // Payload bytes derived from the message sequence number, so a reader can tell
 // a whole, untouched message from a corrupted or reused one.
 void fill_payload(std::span<std::uint8_t> payload, std::uint64_t seq);

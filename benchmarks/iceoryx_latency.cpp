@@ -1,7 +1,8 @@
 // Eclipse iceoryx (Debian's 2.0) measured exactly like agnocast: the payload
 // is written into a loaned chunk, the clock starts right before publish, and
 // the subscriber, asleep in a WaitSet (no busy polling), stops it on taking
-// the chunk.  Run by agnocast-bench with RouDi already up.
+// the chunk.  Run by agnocast-bench with RouDi already up.  With --steady,
+// one message a millisecond and no acks: each side reports its CPU time.
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstring>
@@ -26,60 +27,127 @@ struct Header {
   std::int64_t t0_ns;
 };
 
-const iox::capro::ServiceDescription service{"agnocast_bench", "latency", "chunk"};
+// Each measurement has its own service instance and runtime names, so
+// nothing RouDi still holds of an earlier pair's processes meets this pair.
+iox::capro::ServiceDescription service_of(const std::string& instance) {
+  return {"agnocast_bench", iox::capro::IdString_t(iox::cxx::TruncateToCapacity, instance),
+          "chunk"};
+}
 
-int run_publisher(std::size_t size, std::size_t count, int ready_fd, int ack_fd) {
-  iox::runtime::PoshRuntime::initRuntime("agnocast_bench_pub");
-  iox::popo::UntypedPublisher publisher(service);
+iox::RuntimeName_t runtime_name(const char* role, const std::string& instance) {
+  return iox::RuntimeName_t(iox::cxx::TruncateToCapacity,
+                            std::string("agnocast_bench_") + role + "_" + instance);
+}
+
+struct Options {
+  std::size_t size = 64;
+  std::size_t count = 100;
+  std::size_t scratch_bytes = 0;
+  bool steady = false;
+  std::string instance = "0";
+  int ready_fd = -1, ack_fd = -1, results_fd = -1;
+};
+
+void report_cpu(int results_fd, std::int64_t side, std::int64_t cpu_ns) {
+  const std::int64_t report[2] = {side, cpu_ns};
+  bench::write_all(results_fd, report, sizeof report);
+}
+
+int run_publisher(const Options& options) {
+  iox::runtime::PoshRuntime::initRuntime(runtime_name("pub", options.instance));
+  iox::popo::UntypedPublisher publisher(service_of(options.instance));
   char byte = 0;
-  if (!bench::read_all(ready_fd, &byte, 1)) return 1;
+  if (!bench::read_all(options.ready_fd, &byte, 1)) return 1;
   while (!publisher.hasSubscribers()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  for (std::size_t seq = 0; seq < count; ++seq) {
-    auto loan = publisher.loan(static_cast<std::uint32_t>(sizeof(Header) + size), alignof(Header));
+  bench::SharedScratch scratch(options.scratch_bytes);
+  const std::size_t total =
+      options.steady ? bench::steady_warmup_messages + options.count : options.count;
+  std::int64_t next = bench::now_ns(), cpu0 = 0;
+  for (std::size_t seq = 0; seq < total; ++seq) {
+    if (options.steady) {
+      next += bench::steady_period_ns;
+      bench::sleep_until_ns(next);
+    }
+    auto loan =
+        publisher.loan(static_cast<std::uint32_t>(sizeof(Header) + options.size), alignof(Header));
     if (loan.has_error()) {
-      std::cerr << "iceoryx: loan of " << size << " bytes failed\n";
+      std::cerr << "iceoryx: loan of " << options.size << " bytes failed\n";
       return 1;
     }
     auto* chunk = static_cast<std::uint8_t*>(loan.value());
-    bench::fill_payload(std::span(chunk + sizeof(Header), size), seq);
+    bench::fill_payload(std::span(chunk + sizeof(Header), options.size), seq);
+    bench::fill_payload(scratch.bytes(), seq);
     auto* header = reinterpret_cast<Header*>(chunk);
     header->seq = seq;
     header->t0_ns = bench::now_ns();
     publisher.publish(chunk);
-    if (!bench::read_all(ack_fd, &byte, 1)) return 1;
+    if (options.steady) {
+      if (seq + 1 == bench::steady_warmup_messages) cpu0 = bench::cpu_time_ns();
+      continue;
+    }
+    if (!bench::read_all(options.ack_fd, &byte, 1)) return 1;
     bench::settle_between_messages();
   }
+  if (options.steady) report_cpu(options.results_fd, 0, bench::cpu_time_ns() - cpu0);
   return 0;
 }
 
-int run_subscriber(std::size_t size, std::size_t count, int ready_fd, int ack_fd, int results_fd) {
-  iox::runtime::PoshRuntime::initRuntime("agnocast_bench_sub");
-  iox::popo::SubscriberOptions options;
-  options.queueCapacity = 16;
-  iox::popo::UntypedSubscriber subscriber(service, options);
+int run_subscriber(const Options& options) {
+  iox::runtime::PoshRuntime::initRuntime(runtime_name("sub", options.instance));
+  iox::popo::SubscriberOptions subscriber_options;
+  subscriber_options.queueCapacity = 16;
+  iox::popo::UntypedSubscriber subscriber(service_of(options.instance), subscriber_options);
   iox::popo::WaitSet<> waitset;
   if (waitset.attachState(subscriber, iox::popo::SubscriberState::HAS_DATA).has_error()) return 1;
   char byte = 1;
-  bench::write_all(ready_fd, &byte, 1);
+  bench::write_all(options.ready_fd, &byte, 1);
 
+  const std::size_t total =
+      options.steady ? bench::steady_warmup_messages + options.count : options.count;
   std::vector<std::int64_t> latencies;
-  latencies.reserve(count);
-  while (latencies.size() < count) {
+  latencies.reserve(total);
+  // In a fixed-rate run the subscription may complete after the first
+  // messages were sent: CPU is counted from the first message after the
+  // warm-up that arrives, over the messages that arrive after it.
+  std::int64_t cpu0 = 0;
+  std::size_t counted = 0;
+  bool counting = false, done = false;
+  while (!done) {
     waitset.wait();
-    while (latencies.size() < count) {
+    while (!done) {
       auto taken = subscriber.take();
       if (taken.has_error()) break;
       std::int64_t t1 = bench::now_ns();
       auto* chunk = static_cast<const std::uint8_t*>(taken.value());
       Header header;
       std::memcpy(&header, chunk, sizeof header);
-      bool intact = bench::payload_intact(std::span(chunk + sizeof(Header), size), header.seq);
+      if (options.steady) {
+        subscriber.release(taken.value());
+        if (counting) ++counted;
+        if (!counting && header.seq + 1 >= bench::steady_warmup_messages) {
+          counting = true;
+          cpu0 = bench::cpu_time_ns();
+        }
+        done = header.seq + 1 == total;
+        continue;
+      }
+      bool intact =
+          bench::payload_intact(std::span(chunk + sizeof(Header), options.size), header.seq);
       latencies.push_back(intact ? t1 - header.t0_ns : -1);
       subscriber.release(taken.value());
-      bench::write_all(ack_fd, &byte, 1);
+      bench::write_all(options.ack_fd, &byte, 1);
+      done = latencies.size() == total;
     }
   }
-  bench::send_latencies(results_fd, latencies);
+  if (options.steady) {
+    if (counted == 0) return 1;
+    // Scaled to the publisher's count, so the runner divides both alike.
+    const double per_message = static_cast<double>(bench::cpu_time_ns() - cpu0) / counted;
+    report_cpu(options.results_fd, 1,
+               static_cast<std::int64_t>(per_message * static_cast<double>(options.count)));
+  } else {
+    bench::send_latencies(options.results_fd, latencies);
+  }
   return 0;
 }
 
@@ -89,17 +157,19 @@ int main(int argc, char** argv) {
   CLI::App app{"iceoryx latency role for agnocast-bench"};
   std::string role;
   std::string size_text = "64";
-  std::size_t count = 100;
-  int ready_fd = -1, ack_fd = -1, results_fd = -1;
+  Options options;
   app.add_option("role", role)->required()->check(CLI::IsMember({"pub", "sub"}));
   app.add_option("--size", size_text);
-  app.add_option("--count", count);
-  app.add_option("--ready-fd", ready_fd)->required();
-  app.add_option("--ack-fd", ack_fd)->required();
-  app.add_option("--results-fd", results_fd);
+  app.add_option("--count", options.count);
+  app.add_option("--scratch", options.scratch_bytes, "bytes written elsewhere before each message");
+  app.add_option("--instance", options.instance, "service instance and runtime name suffix");
+  app.add_flag("--steady", options.steady, "one message a millisecond; report CPU time");
+  app.add_option("--ready-fd", options.ready_fd)->required();
+  app.add_option("--ack-fd", options.ack_fd)->required();
+  app.add_option("--results-fd", options.results_fd);
   CLI11_PARSE(app, argc, argv);
   iox::log::LogManager::GetLogManager().SetDefaultLogLevel(iox::log::LogLevel::kWarn);
-  std::size_t size = bench::parse_size(size_text);
-  if (role == "pub") return run_publisher(size, count, ready_fd, ack_fd);
-  return run_subscriber(size, count, ready_fd, ack_fd, results_fd);
+  options.size = bench::parse_size(size_text);
+  if (role == "pub") return run_publisher(options);
+  return run_subscriber(options);
 }

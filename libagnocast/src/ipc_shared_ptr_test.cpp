@@ -14,14 +14,20 @@
 namespace agnocast::detail {
 namespace {
 
-// Stands in for the kernel subscriber: counts RELEASE calls.
+// Stands in for the kernel subscriber: counts RELEASE calls and frees each
+// reference handed back.
 class FakeSubscriber : public EntryOwner {
  public:
   void release_entry(std::uint64_t entry_id) noexcept override {
     released.fetch_add(1);
     last_released.store(entry_id);
   }
+  void recycle(EntryReference* reference) noexcept override {
+    recycled.fetch_add(1);
+    delete reference;
+  }
   std::atomic<int> released{0};
+  std::atomic<int> recycled{0};
   std::atomic<std::uint64_t> last_released{0};
 };
 
@@ -63,6 +69,7 @@ TEST(IpcSharedPtr, LastCopyReleasesOnce) {
   }
   EXPECT_EQ(owner->released.load(), 1);
   EXPECT_EQ(owner->last_released.load(), 9U);
+  EXPECT_EQ(owner->recycled.load(), 1);
 }
 
 TEST(IpcSharedPtr, MoveLeavesTheSourceEmpty) {

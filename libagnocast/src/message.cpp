@@ -68,8 +68,11 @@ void discard_message(void* message) noexcept {
 
 void release(EntryReference* reference) noexcept {
   if (reference->count.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
-  reference->owner->release_entry(reference->entry_id);
-  delete reference;
+  // The reference may hold the owner's last pointer: keep it alive until the
+  // reference is handed back.
+  const std::shared_ptr<EntryOwner> owner = std::move(reference->owner);
+  owner->release_entry(reference->entry_id);
+  owner->recycle(reference);
 }
 
 }  // namespace agnocast::detail

@@ -5,6 +5,7 @@
 #include <mutex>
 #include <span>
 #include <utility>
+#include <vector>
 
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
@@ -30,9 +31,12 @@ class SubscriberEndpoint : public EntryOwner {
   using ReleaseBatch = std::array<std::uint64_t, release_batch>;
 
   SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
-      : runtime_(runtime), id_(runtime.kernel().add_subscriber(request)) {}
+      : runtime_(runtime), id_(runtime.kernel().add_subscriber(request)) {
+    spare_references_.reserve(spare_references_max);
+  }
 
   ~SubscriberEndpoint() override {
+    for (EntryReference* reference : spare_references_) delete reference;
     if (!still_ours()) return;
     try {
       runtime_.kernel().remove_subscriber(id_);
@@ -77,11 +81,33 @@ class SubscriberEndpoint : public EntryOwner {
     for (const std::uint64_t id : ids) release_entry(id);
   }
 
+  // A spare reference when there is one, so that receiving allocates nothing
+  // once as many messages as a callback holds at a time have passed.
   EntryReference* reference_to(std::uint64_t entry_id, std::shared_ptr<EntryOwner> self) {
-    auto* reference = new EntryReference;
+    EntryReference* reference = nullptr;
+    {
+      std::lock_guard lock(spare_mutex_);
+      if (!spare_references_.empty()) {
+        reference = spare_references_.back();
+        spare_references_.pop_back();
+      }
+    }
+    if (!reference) reference = new EntryReference;
+    reference->count.store(1, std::memory_order_relaxed);
     reference->owner = std::move(self);
     reference->entry_id = entry_id;
     return reference;
+  }
+
+  void recycle(EntryReference* reference) noexcept override {
+    {
+      std::lock_guard lock(spare_mutex_);
+      if (spare_references_.size() < spare_references_max) {
+        spare_references_.push_back(reference);  // within the reserved capacity: no allocation
+        return;
+      }
+    }
+    delete reference;
   }
 
   Runtime& runtime() const { return runtime_; }
@@ -91,12 +117,17 @@ class SubscriberEndpoint : public EntryOwner {
   // False in a fork child: the endpoint and its references are the parent's.
   bool still_ours() const { return Runtime::current() == &runtime_; }
 
+  // As many as one receive delivers; more held at once are allocated and freed.
+  static constexpr std::size_t spare_references_max = Kernel::receive_entries_max;
+
   Runtime& runtime_;
   const EndpointId id_;
   std::mutex release_mutex_;
   bool handling_wakeup_ = false;
   ReleaseBatch pending_releases_{};
   std::size_t pending_count_ = 0;
+  std::mutex spare_mutex_;  // releases come from any thread
+  std::vector<EntryReference*> spare_references_;
 };
 
 // Maps every granted pool (closing each descriptor) and throws the first failure.

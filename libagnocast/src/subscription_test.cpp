@@ -74,6 +74,31 @@ TEST_F(SubscriptionTest, AMessageIsReleasedWhenItsLastPointerGoes) {
   EXPECT_EQ(kernel().live_entries(), 1U);
 }
 
+// References go back to the subscriber for reuse: more held at once than it
+// keeps spare, then reused ones, must each point to their own entry and
+// release it exactly once.
+TEST_F(SubscriptionTest, ReusedReferencesEachReleaseTheirOwnEntryOnce) {
+  Node node{"reuse"};
+  const std::string name = topic("reuse");
+  std::vector<ipc_shared_ptr<const Counted>> kept;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{100}, [&](const ipc_shared_ptr<const Counted>& m) { kept.push_back(m); });
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  for (std::uint64_t batch = 0; batch < 3; ++batch) {
+    const int releases_before = kernel().calls().release;
+    for (std::uint64_t seq = 0; seq < 40; ++seq) publish(*publisher, batch * 100 + seq);
+    subscription->handle_wakeup();
+    ASSERT_EQ(kept.size(), 40U);
+    for (std::uint64_t seq = 0; seq < 40; ++seq) {
+      EXPECT_EQ(kept[seq]->seq, batch * 100 + seq);
+      EXPECT_EQ(kept[seq].use_count(), 1U);
+    }
+    kept.clear();
+    EXPECT_EQ(kernel().calls().release - releases_before, 40);
+    EXPECT_EQ(kernel().live_entries(), 1U);  // the newest, in the publisher's window
+  }
+}
+
 TEST_F(SubscriptionTest, AThrowingCallbackReleasesTheRestOfItsBatchAndLosesNothingLater) {
   Node node{"throw"};
   const std::string name = topic("throw");

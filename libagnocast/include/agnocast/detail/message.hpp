@@ -50,11 +50,15 @@ void free_message_memory(void* message) noexcept;
 // Destroys a constructed, unpublished message and frees its memory.
 void discard_message(void* message) noexcept;
 
-// Whoever must hear that a received entry is no longer referenced (the subscriber).
+struct EntryReference;
+
+// Whoever must hear that a received entry is no longer referenced (the
+// subscriber), and takes the reference back for its next message.
 class EntryOwner {
  public:
   virtual ~EntryOwner() = default;
   virtual void release_entry(std::uint64_t entry_id) noexcept = 0;
+  virtual void recycle(EntryReference* reference) noexcept = 0;
 };
 
 // One received entry, shared by every ipc_shared_ptr copy that points to it.

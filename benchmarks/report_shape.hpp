@@ -1,0 +1,17 @@
+// What a report must hold whatever the machine's speed: every series, ratio,
+// interval and count present and sane.  The smoke run in the VM suite fails
+// on any error listed here; speed is never judged.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace agnocast::bench {
+
+std::vector<std::string> report_shape_errors(const nlohmann::ordered_json& report);
+
+// The report as the Markdown tables the README shows.
+void print_markdown(const nlohmann::ordered_json& report);
+
+}  // namespace agnocast::bench

@@ -56,7 +56,6 @@ OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
     : name_(name), descriptor_(-1), owner_pid_(::getpid()) {
   mq_attr attributes{};
   attributes.mq_maxmsg = std::min(static_cast<long>(depth), system_msg_max());
-  capacity_ = static_cast<std::size_t>(attributes.mq_maxmsg);
   attributes.mq_msgsize = sizeof(MqMsgAgnocast);
   const int flags = O_RDONLY | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
   descriptor_ = ::mq_open(name.c_str(), flags, queue_mode, &attributes);
@@ -87,15 +86,11 @@ OwnedQueue::~OwnedQueue() {
   if (::getpid() == owner_pid_) ::mq_unlink(name_.c_str());
 }
 
-std::size_t OwnedQueue::drain() const {
+bool OwnedQueue::take_one() const {
   char buffer[sizeof(MqMsgAgnocast)];
-  std::size_t drained = 0;
   for (;;) {
-    if (::mq_receive(descriptor_, buffer, sizeof buffer, nullptr) >= 0) {
-      ++drained;
-    } else if (errno != EINTR) {
-      return drained;
-    }
+    if (::mq_receive(descriptor_, buffer, sizeof buffer, nullptr) >= 0) return true;
+    if (errno != EINTR) return false;
   }
 }
 

@@ -23,10 +23,8 @@ class OwnedQueue {
 
   int fd() const { return descriptor_; }
   const std::string& name() const { return name_; }
-  // Empties the queue without blocking; returns how many notifications it held.
-  std::size_t drain() const;
-  // How many notifications fit before publishers' sends find it full.
-  std::size_t capacity() const { return capacity_; }
+  // Takes one notification without blocking; false when there was none.
+  bool take_one() const;
   // Queues one notification to ourselves (never blocks; a full queue is fine).
   void notify() const;
 
@@ -34,7 +32,6 @@ class OwnedQueue {
   std::string name_;
   mqd_t descriptor_;
   pid_t owner_pid_;
-  std::size_t capacity_;
 };
 
 // A publisher's sending ends, opened on first use and kept per subscriber id.

@@ -57,10 +57,10 @@ TEST(NotificationQueue, SendersWakeTheOwnerAndNeverBlockWhenFull) {
   for (int i = 0; i < 10; ++i) senders.notify(1);  // must return although the queue is full
   EXPECT_TRUE(readable(queue.fd()));
   EXPECT_EQ(pending(queue.fd()), 2);
-  EXPECT_EQ(queue.capacity(), 2U);
-  EXPECT_EQ(queue.drain(), 2U);
+  EXPECT_TRUE(queue.take_one());
+  EXPECT_TRUE(queue.take_one());
   EXPECT_FALSE(readable(queue.fd()));
-  EXPECT_EQ(queue.drain(), 0U);
+  EXPECT_FALSE(queue.take_one());
   senders.notify(7);  // no such queue: silently nothing
 }
 

@@ -203,12 +203,12 @@ std::size_t SubscriptionBase::handle_wakeup() {
   std::array<ReceivedEntry, Kernel::receive_entries_max> entries;
   std::array<PoolGrant, Kernel::receive_pools_max> pools;
   std::size_t delivered = 0;
-  // Receive before draining the queue, so a callback runs after one system
-  // call.  The drain comes after, followed by one more receive unless it held
-  // a single notification: that one woke us, so its entry was in the first
-  // receive, and no publish came since (a queue of one slot may have refused
-  // a later notification, so it always receives again).
-  bool drained = false;
+  // Take one notification, then receive until nothing is left: three system
+  // calls with the executor's wait, whatever the depth.  A publisher commits
+  // its entry before it notifies, so an entry this receive misses has a
+  // notification still to come, or one still queued (a full queue refuses
+  // one only while it holds another): either wakes us again.
+  state.queue->take_one();
   SubscriberEndpoint::ReleaseBatch releases;
   SubscriberEndpoint& endpoint = *state.endpoint;
   endpoint.set_handling_wakeup(true);
@@ -243,11 +243,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
       for (std::size_t i = handed_out; i < result.entry_count; ++i) release(references[i]);
       throw;
     }
-    if (result.remaining > 0) continue;
-    if (drained) break;
-    const std::size_t notifications = state.queue->drain();
-    drained = true;
-    if (notifications == 1 && state.queue->capacity() > 1) break;
+    if (result.remaining == 0) break;
   }
   return delivered;
 }

@@ -1,11 +1,13 @@
 #include "agnocast/subscription.hpp"
 
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "agnocast/node.hpp"
@@ -15,6 +17,11 @@ namespace agnocast::detail {
 namespace {
 
 using SubscriptionTest = FakeRuntimeTest;
+
+bool readable(int fd) {
+  pollfd entry{fd, POLLIN, 0};
+  return ::poll(&entry, 1, 0) == 1;
+}
 
 void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
   auto message = publisher.borrow_loaned_message();
@@ -34,9 +41,49 @@ TEST_F(SubscriptionTest, OneWakeUpDeliversEveryWaitingMessageOldestFirst) {
   EXPECT_EQ(subscription->handle_wakeup(), 70U);
   ASSERT_EQ(seen.size(), 70U);
   for (std::uint64_t seq = 0; seq < 70; ++seq) EXPECT_EQ(seen[seq], seq);
-  // 32 + 32 + 6 entries, then the drain found many notifications: one more, empty receive.
-  EXPECT_EQ(kernel().calls().receive, 4);
+  // 32 + 32 + 6 entries: the third receive leaves none.
+  EXPECT_EQ(kernel().calls().receive, 3);
   EXPECT_EQ(subscription->handle_wakeup(), 0U);
+}
+
+TEST_F(SubscriptionTest, AWakeUpTakesOneNotificationAndReceivesOnceAtAnyDepth) {
+  for (const std::uint32_t depth : {1U, 10U}) {
+    Node node{"steady"};
+    const std::string name = topic("steady" + std::to_string(depth));
+    int count = 0;
+    auto subscription = node.create_subscription<Counted>(
+        name, QoS{depth}, [&](const ipc_shared_ptr<const Counted>&) { ++count; });
+    auto publisher = node.create_publisher<Counted>(name, QoS{depth});
+    subscription->handle_wakeup();  // the subscription's own first notification
+    const int receives_before = kernel().calls().receive;
+
+    publish(*publisher, 1);
+    EXPECT_EQ(subscription->handle_wakeup(), 1U);
+    EXPECT_EQ(count, 1);
+    EXPECT_EQ(kernel().calls().receive - receives_before, 1) << "depth " << depth;
+    EXPECT_FALSE(readable(subscription->queue_fd())) << "depth " << depth;
+  }
+}
+
+TEST_F(SubscriptionTest, ADroppedMessageIsReleasedByTheNextReceive) {
+  Node node{"batched"};
+  const std::string name = topic("batched");
+  std::vector<std::uint64_t> seen;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>& m) { seen.push_back(m->seq); });
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  subscription->handle_wakeup();
+  const FakeKernel::Calls before = kernel().calls();
+
+  publish(*publisher, 1);
+  subscription->handle_wakeup();
+  publish(*publisher, 2);
+  subscription->handle_wakeup();
+  const FakeKernel::Calls after = kernel().calls();
+  EXPECT_EQ(seen, (std::vector<std::uint64_t>{1, 2}));
+  EXPECT_EQ(after.release, before.release);  // no RELEASE call of its own
+  EXPECT_EQ(after.released_entries - before.released_entries, 1);
+  EXPECT_EQ(after.receive - before.receive, 2);
 }
 
 TEST_F(SubscriptionTest, ASingleNotificationCostsOneReceive) {

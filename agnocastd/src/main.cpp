@@ -1,5 +1,5 @@
 // agnocastd: loads agnocast.ko, then removes what dead agnocast processes
-// leave behind until SIGTERM. See SPEC.md §7 and agnocastd/README.md.
+// leave behind until SIGTERM. See agnocastd/README.md.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>

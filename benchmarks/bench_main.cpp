@@ -1,4 +1,4 @@
-// agnocast-bench: every measurement of SPEC §9 in one run on one machine, so
+// agnocast-bench: every measurement in one run on one machine, so
 // the ratios between agnocast and its yardsticks hold even where absolute
 // times do not (the test VM runs under TCG emulation on a shared host).
 #include <poll.h>

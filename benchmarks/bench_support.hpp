@@ -25,7 +25,7 @@ void sleep_until_ns(std::int64_t deadline_ns);
 std::int64_t cpu_time_ns();
 
 // Bytes written before each sample besides the payload, so that every payload
-// size is preceded by the same number of written bytes (SPEC §9: payload +
+// size is preceded by the same number of written bytes (payload +
 // scratch = 64 MiB).  Shared memory (a memfd), the kind the zero-copy
 // transports' payloads live in.
 class SharedScratch {

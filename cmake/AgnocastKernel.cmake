@@ -5,6 +5,16 @@
 # AGNOCAST_KERNEL_RELEASE and AGNOCAST_VM_KERNEL_IMAGE describe the stock
 # kernel, which the native build and the single-kernel tests use.
 set(KDIR "$ENV{KDIR}" CACHE PATH "Kernel build directory the module is built against")
+# OFF: user space only (the build matrix's other build types, packages): no
+# agnocast.ko, no VM suite.
+option(AGNOCAST_BUILD_MODULE "Build agnocast.ko and register the VM suite" ON)
+if(NOT AGNOCAST_BUILD_MODULE)
+  set(AGNOCAST_KERNELS)
+  set(AGNOCAST_KERNEL_RELEASE "")
+  set(KDIR "")
+  message(STATUS "AGNOCAST_BUILD_MODULE is OFF: user space only, no module and no VM suite")
+  return()
+endif()
 
 execute_process(COMMAND "${PROJECT_SOURCE_DIR}/tests/vm/kernels" list
                 OUTPUT_VARIABLE _agnocast_kernel_lines RESULT_VARIABLE _agnocast_kernels_rc)

@@ -1,4 +1,4 @@
-// agnocast-listener: verifies every message it receives (SPEC §5).
+// agnocast-listener: verifies every message it receives.
 #include <CLI/CLI.hpp>
 #include <agnocast/agnocast.hpp>
 #include <chrono>

@@ -1,4 +1,4 @@
-// agnocast-talker: publishes integrity-checkable messages (SPEC §5).
+// agnocast-talker: publishes integrity-checkable messages.
 #include <CLI/CLI.hpp>
 #include <agnocast/agnocast.hpp>
 #include <agnocast/inspect.hpp>

@@ -1,4 +1,4 @@
-// The bridge's configuration (SPEC §12), read from JSON:
+// The bridge's configuration, read from JSON:
 //   {"domain_id": 0,
 //    "topics": [{"name": "/points", "type": "sensor_msgs/msg/PointCloud2",
 //                "direction": "to_dds",

@@ -110,6 +110,7 @@ int run_cli(int argc, const char* const* argv_given, InspectionSource& source, s
   set_topic_command(app, context);
   set_queue_command(app, context);
   set_node_command(app, context);
+  set_process_command(app, context);
   set_daemon_command(app, context);
   set_doctor_command(app, context);
   set_policy_command(app, context);

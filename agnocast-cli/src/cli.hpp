@@ -1,5 +1,5 @@
 // The command-line front: parses, runs the chosen command, renders its value,
-// and turns every failure into the exit codes SPEC §6 fixes.
+// and turns every failure into the CLI's exit codes (0, 1 runtime, 2 usage).
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -45,15 +45,18 @@ TEST(Cli, JsonGlobalOrPerSubcommandPrintsExactlyOneObject) {
 }
 
 TEST(Cli, EveryCommandRunsOnAHealthySystem) {
-  const std::vector<std::vector<const char*>> commands = {{"topic", "list"},
-                                                          {"topic", "info", "/chatter"},
-                                                          {"topic", "hz", "/chatter"},
-                                                          {"queue", "list"},
-                                                          {"node", "list"},
-                                                          {"daemon", "status"},
-                                                          {"doctor"},
-                                                          {"policy", "show"},
-                                                          {"version"}};
+  const std::vector<std::vector<const char*>> commands = {
+      {"topic", "list"},
+      {"topic", "info", "/chatter"},
+      {"topic", "hz", "/chatter", "--count", "1"},
+      {"node", "info", "talker"},
+      {"process", "list"},
+      {"queue", "list"},
+      {"node", "list"},
+      {"daemon", "status"},
+      {"doctor"},
+      {"policy", "show"},
+      {"version"}};
   for (const auto& command : commands) {
     for (bool json : {false, true}) {
       FakeSource source = healthy_system();
@@ -87,7 +90,7 @@ TEST(Cli, AnUnknownCommandIsNamedWithTheValidOnes) {
   Outcome r = run(source, {"frobnicate"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("unknown command 'frobnicate' for 'agnocast-cli'; valid commands: topic, "
-                       "queue, node, daemon, doctor, policy, version"),
+                       "queue, node, process, daemon, doctor, policy, version"),
             std::string::npos)
       << r.err;
   r = run(source, {"--json", "topic", "lsit"});

@@ -1,6 +1,6 @@
 // Every subcommand: a set_<cmd>_command() that wires it into CLI11 and pure
 // <cmd>_json() functions that build its value from an InspectionSource, plus
-// the table renderers of those values. Shapes follow SPEC §6.
+// the table renderers of those values. Shapes: agnocast-cli/README.md.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -20,12 +20,27 @@ void set_topic_command(CLI::App& app, Context& context);
 nlohmann::json topic_list_json(InspectionSource& source);
 // Throws CliError when no endpoint of the topic exists.
 nlohmann::json topic_info_json(InspectionSource& source, const std::string& topic);
-// Publish rate and bandwidth from the kernel's counters over `window_s`
-// seconds, without subscribing. Throws CliError when the topic has no endpoint.
-nlohmann::json topic_hz_json(InspectionSource& source, const std::string& topic, double window_s);
+// The topic's endpoints; throws CliError when it has none.
+TopicInfo require_topic(InspectionSource& source, const std::string& topic);
 std::string topic_list_table(const nlohmann::json& value);
 std::string topic_info_table(const nlohmann::json& value);
-std::string topic_hz_table(const nlohmann::json& value);
+
+// topic hz TOPIC: one measurement per window: rate_hz, the period's
+// min_s, max_s and std_dev_s (null with fewer than two messages so far) and
+// bytes_per_s of payload, until --count windows or a signal.
+struct HzOptions {
+  std::string topic;
+  double window_s = 1.0;
+  std::optional<std::size_t> count;
+  bool json = false;  // JSON Lines instead of a header and one line per window
+};
+// A subcommand of `topic`.
+void set_topic_hz_command(CLI::App& topic, Context& context);
+// Writes one line per window to `out`; returns the exit code, throws CliError
+// when the topic has no endpoint.
+int topic_hz(InspectionSource& source, const HzOptions& options, std::ostream& out);
+std::string topic_hz_header();
+std::string topic_hz_line(const nlohmann::json& window);
 
 // topic echo TOPIC: subscribes and prints every message decoded from the schema
 // its publisher registered, until --count messages, --timeout or a signal.
@@ -48,6 +63,14 @@ std::string queue_list_table(const nlohmann::json& value);
 void set_node_command(CLI::App& app, Context& context);
 nlohmann::json node_list_json(InspectionSource& source);
 std::string node_list_table(const nlohmann::json& value);
+// node info NODE: the pids using the label and the topics each direction uses,
+// with their types. Throws CliError when no endpoint carries the label.
+nlohmann::json node_info_json(InspectionSource& source, const std::string& node);
+std::string node_info_table(const nlohmann::json& value);
+
+void set_process_command(CLI::App& app, Context& context);
+nlohmann::json process_list_json(InspectionSource& source);
+std::string process_list_table(const nlohmann::json& value);
 
 void set_daemon_command(CLI::App& app, Context& context);
 // `status_path` is agnocastd's status file; its lock file sits beside it.

@@ -90,30 +90,6 @@ TEST(TopicInfo, UnknownTopicIsARuntimeErrorNamingTopicList) {
   }
 }
 
-TEST(TopicHz, RateAndBandwidthFromCounterDeltasOverTheWindow) {
-  FakeSource source = healthy_system();
-  source.on_sleep = [](FakeSource& s) {
-    s.topics[0].publishers[0].published += 20;
-    s.topics[0].publishers[0].published_bytes += 20 * 1000;
-    PublisherInfo late;  // joined during the window: counts from zero
-    late.id = 3;
-    late.published = 5;
-    late.published_bytes = 500;
-    s.topics[0].publishers.push_back(late);
-  };
-  const json value = topic_hz_json(source, "/chatter", 2.0);
-  EXPECT_EQ(value, json::parse(R"({"name":"/chatter","window_s":2.0,"publishers":2,
-                                   "messages":25,"bytes":20500,"rate_hz":12.5,
-                                   "bytes_per_s":10250.0})"));
-  EXPECT_NE(topic_hz_table(value).find("rate_hz      12.5\n"), std::string::npos);
-}
-
-TEST(TopicHz, ASubscriberIsNeverCreated) {
-  FakeSource source = healthy_system();
-  topic_hz_json(source, "/chatter", 1.0);
-  EXPECT_EQ(source.topics[0].subscribers.size(), 2u);
-}
-
 TEST(QueueList, LiveQueueHasOwnerAndDepthStaleQueueHasNulls) {
   FakeSource source = healthy_system();
   source.queues["/ghost@7"] = {0, 10};
@@ -182,6 +158,61 @@ TEST(NodeList, GroupsEndpointsByProcessAndLabel) {
             "talker    100  /chatter,/status  -\n"
             "listener  200  -                 /chatter\n"
             "poller    300  -                 /chatter\n");
+}
+
+TEST(NodeInfo, PidsAndTopicsWithTypesOfOneLabel) {
+  FakeSource source = healthy_system();
+  TopicInfo status;
+  status.name = "/status";
+  PublisherInfo second_talker;  // the same label in another process
+  second_talker.pid = 101;
+  second_talker.node = "talker";
+  status.publishers.push_back(second_talker);
+  source.topics.push_back(status);
+  const json value = node_info_json(source, "talker");
+  EXPECT_EQ(value, json::parse(R"({"name":"talker","pids":[100,101],
+      "publishers":[{"topic":"/chatter","type":"chatter/msg/Message"},
+                    {"topic":"/status","type":null}],
+      "subscribers":[]})"));
+  EXPECT_EQ(node_info_table(value),
+            "node talker\n"
+            "pids 100,101\n"
+            "\n"
+            "DIRECTION  TOPIC     TYPE\n"
+            "publishes  /chatter  chatter/msg/Message\n"
+            "publishes  /status   -\n");
+}
+
+TEST(NodeInfo, AnUnknownNodeIsARuntimeErrorNamingNodeList) {
+  FakeSource source = healthy_system();
+  try {
+    node_info_json(source, "nobody");
+    FAIL() << "expected CliError";
+  } catch (const CliError& e) {
+    EXPECT_NE(std::string(e.what()).find("'nobody'"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("node list"), std::string::npos);
+  }
+}
+
+TEST(ProcessList, NodesUidAndPoolUsage) {
+  FakeSource source = healthy_system();
+  const json value = process_list_json(source);
+  EXPECT_EQ(value, json::parse(R"({"processes":[
+      {"pid":100,"uid":1000,"nodes":["talker"],"publishers":1,"subscribers":0,
+       "pool":{"size":67108864,"used":3145728,"messages":4}},
+      {"pid":200,"uid":1001,"nodes":["listener"],"publishers":0,"subscribers":1,"pool":null},
+      {"pid":300,"uid":null,"nodes":["poller"],"publishers":0,"subscribers":1,"pool":null}]})"));
+  EXPECT_EQ(process_list_table(value),
+            "PID   UID  NODES     PUBLISHERS  SUBSCRIBERS  POOL_SIZE  POOL_USED  MESSAGES\n"
+            "100  1000  talker             1            0   67108864    3145728         4\n"
+            "200  1001  listener           0            1          -          -         -\n"
+            "300     -  poller             0            1          -          -         -\n");
+}
+
+TEST(ProcessList, PoolUseIsNullWhenProcDoesNotTell) {
+  FakeSource source = healthy_system();
+  source.files.erase("/proc/100/smaps");
+  EXPECT_TRUE(process_list_json(source)["processes"][0]["pool"]["used"].is_null());
 }
 
 TEST(DaemonStatus, RunningDaemonReportsItsStatusFile) {

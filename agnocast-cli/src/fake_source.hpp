@@ -41,6 +41,7 @@ class FakeSource : public InspectionSource {
   bool loaded = true;
   Version version = library_version;
   std::vector<TopicInfo> topics;
+  std::vector<ProcessInfo> processes;
   std::optional<AccessPolicy> policy;
   std::map<std::uint32_t, std::string> users;     // uid -> name
   std::map<std::uint32_t, std::string> groups;    // gid -> name
@@ -69,6 +70,10 @@ class FakeSource : public InspectionSource {
                       static_cast<std::uint32_t>(t.subscribers.size()), t.type_name, t.type_hash});
     }
     return list;
+  }
+  std::vector<ProcessInfo> list_processes() override {
+    require_module();
+    return processes;
   }
   std::optional<TopicInfo> topic_info(const std::string& topic) override {
     require_module();
@@ -147,6 +152,7 @@ inline FakeSource healthy_system() {
   talker.depth = 10;
   talker.published = 42;
   talker.published_bytes = 42 * 1024;
+  talker.window = 4;
   talker.uid = 1000;
   chatter.publishers.push_back(talker);
   SubscriberInfo listener;
@@ -170,6 +176,27 @@ inline FakeSource healthy_system() {
   poller.uid = 1001;
   chatter.subscribers.push_back(poller);
   source.topics.push_back(chatter);
+  // The talker's pool: 64 MiB at slot 0, 3 MiB of it resident.
+  ProcessInfo talker_process;
+  talker_process.pid = 100;
+  talker_process.publishers = 1;
+  talker_process.pool_addr = 0x40000000000;
+  talker_process.pool_size = 64 << 20;
+  source.processes.push_back(talker_process);
+  for (const pid_t subscriber : {200, 300}) {
+    ProcessInfo process;
+    process.pid = subscriber;
+    process.subscribers = 1;
+    process.pools_mapped = 1;
+    source.processes.push_back(process);
+  }
+  source.files["/proc/100/status"] = "Name:\ttalker\nUid:\t1000\t1000\t1000\t1000\n";
+  source.files["/proc/200/status"] = "Name:\tlistener\nUid:\t1001\t1001\t1001\t1001\n";
+  source.files["/proc/100/smaps"] =
+      "55d0c0000000-55d0c0001000 r-xp 00000000 08:01 1 /usr/bin/agnocast-talker\n"
+      "Size:                  4 kB\nRss:                   4 kB\n"
+      "40000000000-40004000000 rw-s 00000000 00:01 7 /memfd:agnocast-pool (deleted)\n"
+      "Size:              65536 kB\nRss:                3072 kB\nPss:                3072 kB\n";
   source.queues["/chatter@1"] = {3, 10};
   source.paths = {"/sys/module/agnocast", "/dev/agnocast"};
   source.files["/proc/mounts"] =

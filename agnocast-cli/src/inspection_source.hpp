@@ -49,6 +49,8 @@ class InspectionSource {
   // These throw agnocast::ModuleNotLoaded when the module is absent.
   virtual std::vector<TopicSummary> list_topics() = 0;
   virtual std::optional<TopicInfo> topic_info(const std::string& topic) = 0;
+  // Every process registered with the module in this IPC namespace.
+  virtual std::vector<ProcessInfo> list_processes() = 0;
   // The topic access policy in force; nullopt when there is none.
   virtual std::optional<AccessPolicy> access_policy() = 0;
 

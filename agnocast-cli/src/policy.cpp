@@ -1,5 +1,5 @@
 // agnocast-cli policy show: the topic access policy the kernel enforces in
-// this IPC namespace (SPEC §10), with user and group ids shown by name.
+// this IPC namespace (agnocastd/README.md, "access"), with user and group ids shown by name.
 #include <string>
 
 #include "commands.hpp"

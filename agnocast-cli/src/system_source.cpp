@@ -87,6 +87,7 @@ class SystemSource final : public InspectionSource {
     }
   }
   std::vector<TopicSummary> list_topics() override { return agnocast::list_topics(); }
+  std::vector<ProcessInfo> list_processes() override { return agnocast::list_processes(); }
   std::optional<TopicInfo> topic_info(const std::string& topic) override {
     return agnocast::topic_info(topic);
   }

@@ -1,4 +1,4 @@
-// agnocast-cli topic list | info TOPIC | hz TOPIC [--window SEC] (echo: echo.cpp)
+// agnocast-cli topic list | info TOPIC (hz: topic_hz.cpp, echo: echo.cpp)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,17 +13,6 @@ namespace {
 
 using nlohmann::json;
 using Align = Table::Align;
-
-double round3(double x) { return std::round(x * 1000.0) / 1000.0; }
-
-TopicInfo require_topic(InspectionSource& source, const std::string& topic) {
-  std::optional<TopicInfo> info = source.topic_info(topic);
-  if (!info) {
-    throw CliError("no publisher or subscriber uses topic '" + topic +
-                   "'; `agnocast-cli topic list` shows the topics that exist");
-  }
-  return *info;
-}
 
 json pending_of(InspectionSource& source, const std::optional<std::string>& queue) {
   if (!queue) return nullptr;
@@ -46,6 +35,15 @@ const CLI::Validator topic_name_validator(
     [](std::string& topic) { return topic_name_problem(topic); }, "TOPIC", "topic name");
 
 }  // namespace
+
+TopicInfo require_topic(InspectionSource& source, const std::string& topic) {
+  std::optional<TopicInfo> info = source.topic_info(topic);
+  if (!info) {
+    throw CliError("no publisher or subscriber uses topic '" + topic +
+                   "'; `agnocast-cli topic list` shows the topics that exist");
+  }
+  return *info;
+}
 
 json topic_list_json(InspectionSource& source) {
   std::vector<TopicSummary> topics = source.list_topics();
@@ -103,43 +101,6 @@ json topic_info_json(InspectionSource& source, const std::string& topic) {
           {"subscribers", subscribers}};
 }
 
-json topic_hz_json(InspectionSource& source, const std::string& topic, double window_s) {
-  struct Counters {
-    std::uint64_t messages = 0;
-    std::uint64_t bytes = 0;
-  };
-  auto sample = [&] {
-    std::map<std::uint32_t, Counters> by_publisher;
-    for (const PublisherInfo& p : require_topic(source, topic).publishers) {
-      by_publisher[p.id] = {p.published, p.published_bytes};
-    }
-    return by_publisher;
-  };
-  const auto before = sample();
-  const double start = source.now_seconds();
-  source.sleep_seconds(window_s);
-  const auto after = sample();
-  const double elapsed = source.now_seconds() - start;
-
-  // A publisher that joined during the window counts from zero; one that left
-  // takes its last counts with it (the rate then under-reports).
-  Counters delta;
-  for (const auto& [id, now] : after) {
-    const auto then = before.find(id);
-    const Counters base = then == before.end() ? Counters{} : then->second;
-    delta.messages += now.messages - std::min(now.messages, base.messages);
-    delta.bytes += now.bytes - std::min(now.bytes, base.bytes);
-  }
-  const double seconds = elapsed > 0 ? elapsed : window_s;
-  return {{"name", topic},
-          {"window_s", round3(seconds)},
-          {"publishers", after.size()},
-          {"messages", delta.messages},
-          {"bytes", delta.bytes},
-          {"rate_hz", round3(static_cast<double>(delta.messages) / seconds)},
-          {"bytes_per_s", round3(static_cast<double>(delta.bytes) / seconds)}};
-}
-
 std::string topic_list_table(const json& value) {
   Table table({{"NAME"}, {"TYPE"}, {"PUBLISHERS", Align::right}, {"SUBSCRIBERS", Align::right}});
   for (const json& t : value.at("topics")) {
@@ -187,11 +148,6 @@ std::string topic_info_table(const json& value) {
          "\n\npublishers\n" + publishers.render() + "\nsubscribers\n" + subscribers.render();
 }
 
-std::string topic_hz_table(const json& value) {
-  return key_value_lines(
-      value, {"name", "window_s", "publishers", "messages", "bytes", "rate_hz", "bytes_per_s"});
-}
-
 void set_topic_command(CLI::App& app, Context& context) {
   CLI::App* topic = app.add_subcommand("topic", "Topics, their endpoints and publish rates");
   topic->require_subcommand(1);
@@ -209,18 +165,7 @@ void set_topic_command(CLI::App& app, Context& context) {
       *info, context,
       {[&context, name] { return topic_info_json(context.source, *name); }, topic_info_table});
 
-  auto window = std::make_shared<double>(1.0);
-  CLI::App* hz = topic->add_subcommand(
-      "hz", "Publish rate and bandwidth of a topic, from kernel counters, without subscribing");
-  hz->add_option("TOPIC", *name, "Topic name, e.g. /chatter")
-      ->required()
-      ->check(topic_name_validator);
-  hz->add_option("--window", *window, "Seconds to sample over")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  bind_command(*hz, context,
-               {[&context, name, window] { return topic_hz_json(context.source, *name, *window); },
-                topic_hz_table});
+  set_topic_hz_command(*topic, context);
   set_topic_echo_command(*topic, context);
 }
 

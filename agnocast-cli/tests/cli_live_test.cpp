@@ -256,24 +256,54 @@ TEST_F(CliLive, TopicInfo) {
   EXPECT_NE(table.out.find("PENDING  UNRECEIVED  HELD  RECEIVED  DROPPED"), std::string::npos);
 }
 
-TEST_F(CliLive, TopicHzMeasuresWithoutSubscribing) {
-  const Outcome r = cli("topic hz " + topic + " --window 2 --json");
+TEST_F(CliLive, TopicHzMeasuresRateJitterAndPayloadWithoutSubscribing) {
+  const Outcome r = cli("topic hz " + topic + " --window 2 --count 2 --json");
   ASSERT_EQ(r.code, 0) << r.err;
-  const json hz = r.value();
-  EXPECT_EQ(hz["name"], topic);
-  EXPECT_GE(hz["window_s"].get<double>(), 2.0);
-  EXPECT_GT(hz["messages"].get<int>(), 0);
-  EXPECT_GT(hz["rate_hz"].get<double>(), 0.0);
-  // The library reports a fixed size per publish (the message object itself;
-  // nested containers are not counted), so bytes are a multiple of messages.
-  EXPECT_GT(hz["bytes_per_s"].get<double>(), 0.0);
-  EXPECT_EQ(hz["bytes"].get<std::uint64_t>() % hz["messages"].get<std::uint64_t>(), 0u);
+  const auto windows = lines_of(r.out);
+  ASSERT_EQ(windows.size(), 2u) << r.out;
+  for (const auto& line : windows) {
+    const json hz = json::parse(line);
+    EXPECT_EQ(hz["name"], topic);
+    EXPECT_GE(hz["window_s"].get<double>(), 2.0);
+    // The talker publishes at 50 Hz: a period of 20 ms, give or take the VM.
+    EXPECT_GT(hz["messages"].get<int>(), 20);
+    EXPECT_GT(hz["rate_hz"].get<double>(), 10.0);
+    EXPECT_LE(hz["min_s"].get<double>(), 0.021);
+    EXPECT_GE(hz["max_s"].get<double>(), 0.019);
+    EXPECT_GE(hz["std_dev_s"].get<double>(), 0.0);
+    EXPECT_LE(hz["min_s"].get<double>(), hz["max_s"].get<double>());
+    // Payload bytes: each message carries its 1000-byte payload besides the
+    // message object, so more than 1000 bytes per message are counted.
+    EXPECT_GT(hz["bytes"].get<std::uint64_t>(), 1000u * hz["messages"].get<std::uint64_t>());
+  }
   EXPECT_EQ(find_by(cli("topic list --json").value()["topics"], "name", topic)["subscribers"], 2);
 
-  const Outcome table = cli("topic hz " + topic + " --window 1");
+  const Outcome table = cli("topic hz " + topic + " --window 1 --count 1");
   ASSERT_EQ(table.code, 0);
-  EXPECT_EQ(row_starting(table.out, "name"), (std::vector<std::string>{"name", topic}));
-  EXPECT_EQ(row_starting(table.out, "rate_hz").size(), 2u);
+  EXPECT_EQ(row_starting(table.out, "RATE_HZ"),
+            (std::vector<std::string>{"RATE_HZ", "MIN_S", "MAX_S", "STD_DEV_S", "BYTES_PER_S",
+                                      "MESSAGES", "PUBLISHERS"}));
+  EXPECT_EQ(lines_of(table.out).size(), 2u) << table.out;
+}
+
+TEST_F(CliLive, NodeInfoAndProcessListShowTheTalker) {
+  const json node = cli("node info talker --json").value();
+  EXPECT_EQ(node["pids"], json::array({talker}));
+  EXPECT_EQ(node["publishers"][0]["topic"], topic);
+  EXPECT_EQ(node["publishers"][0]["type"], "chatter/msg/Message");
+
+  const json processes = cli("process list --json").value()["processes"];
+  const json talker_process = find_by(processes, "pid", talker);
+  ASSERT_FALSE(talker_process.is_null()) << processes.dump();
+  EXPECT_EQ(talker_process["uid"], 0);
+  EXPECT_EQ(talker_process["nodes"], json::array({"talker"}));
+  const json pool = talker_process["pool"];
+  ASSERT_FALSE(pool.is_null()) << processes.dump();
+  EXPECT_GT(pool["size"].get<std::uint64_t>(), 0u);
+  // The talker has written messages into its pool: some of it is resident.
+  EXPECT_GT(pool["used"].get<std::uint64_t>(), 0u);
+  EXPECT_LE(pool["used"].get<std::uint64_t>(), pool["size"].get<std::uint64_t>());
+  EXPECT_GE(pool["messages"].get<std::uint64_t>(), 1u);
 }
 
 TEST_F(CliLive, QueueListShowsOwnersDepthsAndTheStaleGhost) {

@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "agnocast/inspect.hpp"
+#include "daemon_signals.hpp"
 #include "errno_error.hpp"
 #include "module_loader.hpp"
 #include "notify.hpp"
@@ -22,15 +23,6 @@
 namespace agnocastd {
 
 namespace {
-
-sigset_t daemon_signals() {
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGHUP);
-  return signals;
-}
 
 // A descriptor closed when the scope ends.
 class Fd {
@@ -75,11 +67,6 @@ void sweep_now(Supervisor& supervisor) {
 }
 
 }  // namespace
-
-void block_daemon_signals() {
-  const sigset_t signals = daemon_signals();
-  if (::sigprocmask(SIG_BLOCK, &signals, nullptr) != 0) throw_errno("sigprocmask");
-}
 
 void clean_exited_processes(Supervisor& supervisor) {
   bool cleaned = false;

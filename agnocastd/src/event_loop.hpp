@@ -41,10 +41,6 @@ struct Supervisor {
   std::chrono::system_clock::time_point started_at = std::chrono::system_clock::now();
 };
 
-// Blocks SIGTERM, SIGINT and SIGHUP so that they queue for serve()'s signalfd
-// even while the daemon is still starting.
-void block_daemon_signals();
-
 // Cleans up after every process whose exit records wait now; sweeps when
 // the kernel discarded records unread.
 void clean_exited_processes(Supervisor& supervisor);

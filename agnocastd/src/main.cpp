@@ -1,6 +1,5 @@
 // agnocastd: loads agnocast.ko, then removes what dead agnocast processes
-// leave behind until SIGTERM. See SPEC.md §7 and agnocastd/README.md.
-#include <spdlog/sinks/stdout_sinks.h>
+// leave behind until SIGTERM. See agnocastd/README.md.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -13,10 +12,13 @@
 #include "agnocast/supervise.hpp"
 #include "agnocastd/status_file.hpp"
 #include "config.hpp"
+#include "daemon_signals.hpp"
 #include "event_loop.hpp"
 #include "host.hpp"
 #include "instance_lock.hpp"
+#include "journal_log.hpp"
 #include "module_loader.hpp"
+#include "module_parameters.hpp"
 #include "mqueue_setup.hpp"
 #include "notify.hpp"
 #include "reload.hpp"
@@ -35,28 +37,46 @@ struct Options {
   bool check_config = false;
 };
 
+// A parameter agnocast.ko does not declare, or a value its type cannot take,
+// is a configuration error: it would otherwise fail the load, or be ignored.
+void check_module_parameters(const agnocastd::Config& config) {
+  if (config.module_parameters.empty()) return;
+  const auto declared = agnocastd::declared_module_parameters(config.module_path);
+  if (!declared) {
+    spdlog::warn(
+        "module_parameters not checked: modinfo cannot read {} and agnocast.ko is not loaded",
+        config.module_path.value_or("the installed agnocast module"));
+    return;
+  }
+  agnocastd::check_module_parameters(config.module_parameters, *declared);
+}
+
 // Throws CLI::ParseError or agnocastd::ConfigError.
 agnocastd::Config read_config(const Options& options, bool config_given) {
   agnocastd::Config config = agnocastd::load_config(options.config_path, !config_given);
   if (options.module_path) config.module_path = options.module_path;
   if (options.no_load) config.load_module = false;
   if (options.log_level) config.log_level = *options.log_level;
+  check_module_parameters(config);
   return config;
 }
 
-void set_up_logging(const std::string& level) {
-  auto logger = spdlog::stderr_logger_st("agnocastd");
-  // journald stamps each line itself.
-  logger->set_pattern(std::getenv("JOURNAL_STREAM") ? "%^%l%$: %v" : "[%Y-%m-%d %T.%e] [%l] %v");
-  logger->set_level(spdlog::level::from_str(level));
-  logger->flush_on(spdlog::level::trace);
-  spdlog::set_default_logger(logger);
+// A module someone else loaded keeps its parameters: say where they differ.
+void log_loaded_parameter_differences(const agnocastd::Config& config) {
+  if (config.module_parameters.empty()) return;
+  const auto declared = agnocastd::declared_module_parameters(config.module_path);
+  for (const auto& difference : agnocastd::loaded_parameter_differences(
+           config.module_parameters, declared.value_or(agnocastd::DeclaredParameters{}),
+           agnocastd::loaded_module_parameters())) {
+    spdlog::warn("{}", difference);
+  }
 }
 
 // Loads agnocast.ko unless it is there; true when this call loaded it.
 bool bring_up_module(const agnocastd::Config& config) {
   if (agnocastd::module_present()) {
     spdlog::info("agnocast.ko is already loaded");
+    log_loaded_parameter_differences(config);
     return false;
   }
   if (!config.load_module) {
@@ -171,12 +191,14 @@ int main(int argc, char** argv) {
     return app.exit(error) == EXIT_SUCCESS ? EXIT_SUCCESS : exit_usage;  // --help is no error
   }
 
+  // Before the configuration: reading it may log.
+  agnocastd::set_up_logging(options.log_level.value_or("info"), agnocastd::stderr_is_journal());
   const bool config_given = app.count("--config") > 0;
   agnocastd::Config config;
   try {
     config = read_config(options, config_given);
   } catch (const agnocastd::ConfigError& error) {
-    fmt::print(stderr, "agnocastd: {}\n", error.what());
+    spdlog::error("{}", error.what());
     return exit_usage;
   }
   if (options.check_config) {
@@ -184,9 +206,12 @@ int main(int argc, char** argv) {
     return EXIT_SUCCESS;
   }
 
-  set_up_logging(config.log_level);
+  spdlog::set_level(spdlog::level::from_str(config.log_level));
   try {
     return run(config, [&options, config_given] { return read_config(options, config_given); });
+  } catch (const agnocastd::StopRequested& stop) {
+    spdlog::info("agnocastd stopped while starting ({})", stop.what());
+    return EXIT_SUCCESS;
   } catch (const std::exception& error) {
     spdlog::error("{}", error.what());
     return exit_failure;

@@ -2,18 +2,17 @@
 
 #include <fcntl.h>
 #include <grp.h>
-#include <spawn.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
-#include <thread>
+#include <system_error>
 #include <vector>
 
-extern char** environ;
+#include "child_process.hpp"
+#include "daemon_signals.hpp"
 
 namespace agnocastd {
 
@@ -53,19 +52,13 @@ void insmod(const std::string& path, const std::string& parameters) {
 void modprobe(const std::map<std::string, std::string>& parameters) {
   std::vector<std::string> words{"modprobe", module_name};
   for (const auto& [name, value] : parameters) words.push_back(name + "=" + value);
-  std::vector<char*> argv;
-  for (auto& word : words) argv.push_back(word.data());
-  argv.push_back(nullptr);
-  pid_t child = 0;
-  const int spawn_error =
-      ::posix_spawnp(&child, "modprobe", nullptr, nullptr, argv.data(), environ);
-  if (spawn_error != 0) {
-    throw ModuleError(std::string("cannot run modprobe: ") + std::strerror(spawn_error));
+  bool loaded = false;
+  try {
+    loaded = run_child_until_stopped(words);
+  } catch (const std::system_error& error) {
+    throw ModuleError(std::string("cannot run modprobe: ") + error.code().message());
   }
-  int status = 0;
-  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+  if (!loaded) {
     throw ModuleError(
         "modprobe agnocast failed: is the module installed (dkms status agnocast)? Or pass "
         "--module PATH to the .ko");
@@ -87,7 +80,9 @@ bool wait_for_device(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (::access(device_path, F_OK) != 0) {
     if (std::chrono::steady_clock::now() >= deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (stop_requested(std::chrono::milliseconds(20))) {
+      throw StopRequested("waiting for /dev/agnocast");
+    }
   }
   return true;
 }

@@ -24,11 +24,13 @@ bool module_present();
 std::string module_parameter_string(const std::map<std::string, std::string>& parameters);
 
 // insmod of path (finit_module) when given, else `modprobe agnocast`;
-// throws ModuleError saying what failed.
+// throws ModuleError saying what failed, StopRequested on SIGTERM/SIGINT
+// while modprobe runs.
 void load_module(const std::optional<std::string>& path,
                  const std::map<std::string, std::string>& parameters);
 
-// Waits for /dev/agnocast; false after timeout.
+// Waits for /dev/agnocast; false after timeout. Throws StopRequested on
+// SIGTERM/SIGINT meanwhile.
 bool wait_for_device(std::chrono::milliseconds timeout);
 
 // Empty when this daemon can work with the module, else the reason.

@@ -1,4 +1,4 @@
-// SPEC §10 as an attacker tries it: pools nobody else can write, the topic
+// The security model as an attacker tries it: pools nobody else can write, the topic
 // access policy, shedding for slow subscribers, exit records that are never
 // dropped silently and namespace state that ends with its namespace.  Runs as
 // root in the VM; attackers are forked children that drop to other users.

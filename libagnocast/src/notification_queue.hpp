@@ -1,4 +1,4 @@
-// The POSIX message queues that carry "something new for you" (SPEC §3).
+// The POSIX message queues that carry "something new for you".
 #pragma once
 
 #include <mqueue.h>

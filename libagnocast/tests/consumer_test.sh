@@ -9,7 +9,10 @@ rm -rf "$scratch"
 mkdir -p "$scratch"
 prefix=$scratch/prefix
 
-cmake --install "$build" --prefix "$prefix" --component agnocast_library >/dev/null
+# What libagnocast-dev and the libagnocast0 it depends on install.
+for component in agnocast_runtime agnocast_library; do
+  cmake --install "$build" --prefix "$prefix" --component "$component" >/dev/null
+done
 
 cmake -S "$source" -B "$scratch/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
 cmake --build "$scratch/cmake-build" >/dev/null

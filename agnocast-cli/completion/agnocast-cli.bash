@@ -1,0 +1,50 @@
+# bash completion for agnocast-cli: commands, subcommands, options, and the
+# names of live topics and nodes, which agnocast-cli itself lists.
+
+_agnocast_cli_names() {  # topic | node: the first column of `agnocast-cli X list`
+  agnocast-cli "$1" list 2>/dev/null | awk 'NR > 1 && $1 != "" { print $1 }'
+}
+
+_agnocast_cli() {
+  local cur=${COMP_WORDS[COMP_CWORD]} prev=${COMP_WORDS[COMP_CWORD - 1]}
+  local words=() word i
+  for ((i = 1; i < COMP_CWORD; i++)); do
+    word=${COMP_WORDS[i]}
+    [[ $word == -* ]] || words+=("$word")
+  done
+  case $prev in
+    --window | --count | --timeout | --status-file) return ;;
+  esac
+  local candidates
+  case "${words[0]-} ${words[1]-}" in
+    " ") candidates="topic queue node process daemon doctor policy version --json --help --version" ;;
+    "topic ") candidates="list info hz echo" ;;
+    "queue ") candidates="list" ;;
+    "node ") candidates="list info" ;;
+    "process ") candidates="list" ;;
+    "daemon ") candidates="status" ;;
+    "policy ") candidates="show" ;;
+    "topic info" | "topic hz" | "topic echo")
+      if [[ $cur == -* || ${#words[@]} -ge 3 ]]; then
+        case ${words[1]} in
+          hz) candidates="--window --count --json --help" ;;
+          echo) candidates="--count --timeout --no-arrays --json --help" ;;
+          *) candidates="--json --help" ;;
+        esac
+      else
+        candidates=$(_agnocast_cli_names topic)
+      fi
+      ;;
+    "node info")
+      if [[ $cur == -* || ${#words[@]} -ge 3 ]]; then
+        candidates="--json --help"
+      else
+        candidates=$(_agnocast_cli_names node)
+      fi
+      ;;
+    "daemon status" | "doctor ") candidates="--status-file --json --help" ;;
+    *) candidates="--json --help" ;;
+  esac
+  COMPREPLY=($(compgen -W "$candidates" -- "$cur"))
+}
+complete -F _agnocast_cli agnocast-cli

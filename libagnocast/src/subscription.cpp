@@ -51,20 +51,22 @@ class SubscriberEndpoint : public EntryOwner {
     std::lock_guard lock(release_mutex_);
     pending_releases_[pending_count_++] = entry_id;
     if (handling_wakeup_ && pending_count_ < release_batch) return;
-    try {
-      runtime_.kernel().release(id_, std::span(pending_releases_.data(), pending_count_));
-    } catch (const Error& error) {
-      // Called when the last pointer to a message goes: nobody to throw to.
-      log(LogLevel::warning, std::string("releasing a received message: ") + error.what());
-    }
-    pending_count_ = 0;
+    release_pending();
   }
 
-  // While set (by the thread receiving, under the subscription's receive
-  // mutex), releases wait for the next receive.
-  void set_handling_wakeup(bool handling) {
+  // Called by the thread receiving, under the subscription's receive mutex:
+  // from now until end_wakeup(), releases wait for the next receive.
+  void begin_wakeup() {
     std::lock_guard lock(release_mutex_);
-    handling_wakeup_ = handling;
+    handling_wakeup_ = true;
+  }
+
+  // A wake-up a callback ended by throwing may be the last one for a while:
+  // with release_now its waiting releases go at once.
+  void end_wakeup(bool release_now) noexcept {
+    std::lock_guard lock(release_mutex_);
+    handling_wakeup_ = false;
+    if (release_now && pending_count_ > 0) release_pending();
   }
 
   // Moves the releases waiting for the next receive into batch; returns their number.
@@ -116,6 +118,17 @@ class SubscriberEndpoint : public EntryOwner {
  private:
   // False in a fork child: the endpoint and its references are the parent's.
   bool still_ours() const { return Runtime::current() == &runtime_; }
+
+  // With release_mutex_ held.
+  void release_pending() noexcept {
+    try {
+      runtime_.kernel().release(id_, std::span(pending_releases_.data(), pending_count_));
+    } catch (const Error& error) {
+      // Called when the last pointer to a message goes: nobody to throw to.
+      log(LogLevel::warning, std::string("releasing a received message: ") + error.what());
+    }
+    pending_count_ = 0;
+  }
 
   // As many as one receive delivers; more held at once are allocated and freed.
   static constexpr std::size_t spare_references_max = Kernel::receive_entries_max;
@@ -211,11 +224,12 @@ std::size_t SubscriptionBase::handle_wakeup() {
   state.queue->take_one();
   SubscriberEndpoint::ReleaseBatch releases;
   SubscriberEndpoint& endpoint = *state.endpoint;
-  endpoint.set_handling_wakeup(true);
-  struct StopDeferring {
+  endpoint.begin_wakeup();
+  struct EndWakeup {
     SubscriberEndpoint& endpoint;
-    ~StopDeferring() { endpoint.set_handling_wakeup(false); }
-  } stop_deferring{endpoint};
+    const int exceptions = std::uncaught_exceptions();
+    ~EndWakeup() { endpoint.end_wakeup(std::uncaught_exceptions() > exceptions); }
+  } end_wakeup{endpoint};
   for (;;) {
     const std::span<const std::uint64_t> released(releases.data(),
                                                   state.endpoint->take_releases(releases));

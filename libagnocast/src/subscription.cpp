@@ -22,8 +22,10 @@ namespace {
 // The kernel subscriber. It outlives its Subscription while any received
 // message is still held, so that memory is never reclaimed under a reader.
 // A callback subscriber's releases made while it handles a wake-up (messages
-// dropped by its callbacks) wait for its next receive, which drops them in
-// the same system call; a full batch, and any other release, goes at once.
+// dropped by its callbacks) ride on its next receive of that wake-up; what is
+// left goes in one release when the wake-up ends, so that nothing stays held
+// until the next message (a dead publisher's pool would stay with it). A full
+// batch, and any release outside a wake-up, goes at once.
 class SubscriberEndpoint : public EntryOwner {
  public:
   // Releases one receive carries; a full batch is released at once.
@@ -61,12 +63,11 @@ class SubscriberEndpoint : public EntryOwner {
     handling_wakeup_ = true;
   }
 
-  // A wake-up a callback ended by throwing may be the last one for a while:
-  // with release_now its waiting releases go at once.
-  void end_wakeup(bool release_now) noexcept {
+  // Releases what still waits, in one call.
+  void end_wakeup() noexcept {
     std::lock_guard lock(release_mutex_);
     handling_wakeup_ = false;
-    if (release_now && pending_count_ > 0) release_pending();
+    if (pending_count_ > 0) release_pending();
   }
 
   // Moves the releases waiting for the next receive into batch; returns their number.
@@ -227,8 +228,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
   endpoint.begin_wakeup();
   struct EndWakeup {
     SubscriberEndpoint& endpoint;
-    const int exceptions = std::uncaught_exceptions();
-    ~EndWakeup() { endpoint.end_wakeup(std::uncaught_exceptions() > exceptions); }
+    ~EndWakeup() { endpoint.end_wakeup(); }
   } end_wakeup{endpoint};
   for (;;) {
     const std::span<const std::uint64_t> released(releases.data(),

@@ -57,7 +57,7 @@ class SubscriberEndpoint : public EntryOwner {
   }
 
   // Called by the thread receiving, under the subscription's receive mutex:
-  // from now until end_wakeup(), releases wait for the next receive.
+  // from now until end_wakeup(), releases wait for the next receive or the end.
   void begin_wakeup() {
     std::lock_guard lock(release_mutex_);
     handling_wakeup_ = true;
@@ -218,7 +218,8 @@ std::size_t SubscriptionBase::handle_wakeup() {
   std::array<PoolGrant, Kernel::receive_pools_max> pools;
   std::size_t delivered = 0;
   // Take one notification, then receive until nothing is left: three system
-  // calls with the executor's wait, whatever the depth.  A publisher commits
+  // calls with the executor's wait whatever the depth, and one release at the
+  // end for what the callbacks dropped.  A publisher commits
   // its entry before it notifies, so an entry this receive misses has a
   // notification still to come, or one still queued (a full queue refuses
   // one only while it holds another): either wakes us again.

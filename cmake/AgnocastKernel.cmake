@@ -8,6 +8,9 @@ set(KDIR "$ENV{KDIR}" CACHE PATH "Kernel build directory the module is built aga
 # OFF: user space only (the build matrix's other build types, packages): no
 # agnocast.ko, no VM suite.
 option(AGNOCAST_BUILD_MODULE "Build agnocast.ko and register the VM suite" ON)
+# Empty: every kernel tests/vm/kernels lists as ready.  A list (e.g. "stock")
+# keeps only those: scripts/test --quick.
+set(AGNOCAST_VM_KERNELS "" CACHE STRING "Kernels the VM suite boots (empty: every ready kernel)")
 if(NOT AGNOCAST_BUILD_MODULE)
   set(AGNOCAST_KERNELS)
   set(AGNOCAST_KERNEL_RELEASE "")
@@ -32,6 +35,9 @@ foreach(_line IN LISTS _agnocast_kernel_lines)
   list(GET _fields 1 AGNOCAST_KERNEL_${_name}_RELEASE)
   list(GET _fields 2 AGNOCAST_KERNEL_${_name}_IMAGE)
   list(GET _fields 3 AGNOCAST_KERNEL_${_name}_KDIR)
+  if(AGNOCAST_VM_KERNELS AND NOT _name IN_LIST AGNOCAST_VM_KERNELS)
+    continue()
+  endif()
   list(APPEND AGNOCAST_KERNELS ${_name})
 endforeach()
 

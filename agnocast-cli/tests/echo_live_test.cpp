@@ -1,8 +1,9 @@
-// agnocast-cli topic echo against live publishers in the VM: a generated
-// standard message (geometry_msgs/msg/PoseStamped) and a nested custom type
-// declared with AGNOCAST_MESSAGE. The CLI runs in its own process and decodes
-// what this process publishes from the schema alone; every field it prints
-// must equal what was published.
+// agnocast-cli topic echo against live publishers in the VM: generated
+// standard messages (geometry_msgs/msg/PoseStamped, std_msgs/msg/String, and
+// visualization_msgs/msg/InteractiveMarkerUpdate, the standard type with the
+// largest schema) and a nested custom type declared with AGNOCAST_MESSAGE. The CLI runs in its own
+// process and decodes what this process publishes from the schema alone; every field it prints must
+// equal what was published.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,9 +16,11 @@
 #include <geometry_msgs/msg/pose_stamped.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <std_msgs/msg/string.hpp>
 #include <string>
 #include <thread>
 #include <vector>
+#include <visualization_msgs/msg/interactive_marker_update.hpp>
 
 namespace echo_live {
 
@@ -147,6 +150,31 @@ json expected_batch(std::uint64_t seq) {
           {"even", seq % 2 == 0}};
 }
 
+void fill_string(std_msgs::msg::String& text, std::uint64_t seq) {
+  text.data = "hello world " + std::to_string(seq);
+}
+
+void fill_update(visualization_msgs::msg::InteractiveMarkerUpdate& update, std::uint64_t seq) {
+  update.server_id = "server";
+  update.seq_num = seq;
+  update.type = visualization_msgs::msg::InteractiveMarkerUpdate::UPDATE;
+  visualization_msgs::msg::InteractiveMarker marker;
+  marker.name = "handle";
+  marker.scale = 0.5F;
+  visualization_msgs::msg::InteractiveMarkerControl control;
+  control.name = "move_x";
+  control.interaction_mode = visualization_msgs::msg::InteractiveMarkerControl::MOVE_AXIS;
+  visualization_msgs::msg::Marker shape;
+  shape.type = visualization_msgs::msg::Marker::MESH_RESOURCE;
+  shape.mesh_file.filename = "arrow.stl";
+  shape.mesh_file.data = {1, 2, 3};
+  shape.lifetime.sec = static_cast<std::int32_t>(seq);
+  control.markers.push_back(shape);
+  marker.controls.push_back(control);
+  update.markers.push_back(marker);
+  update.erases.push_back("old");
+}
+
 class TopicEchoLive : public ::testing::Test {
  protected:
   agnocast::Node node_{"echo_live_publisher"};
@@ -164,6 +192,50 @@ TEST_F(TopicEchoLive, GeneratedStandardMessageAsJsonLines) {
     EXPECT_GT(seq, previous);
     previous = seq;
     EXPECT_EQ(message, expected_pose(seq));
+  }
+}
+
+TEST_F(TopicEchoLive, StdMsgsStringAsJsonAndText) {
+  SteadyPublisher<std_msgs::msg::String> publisher(node_, "/echo_string", fill_string);
+  const Outcome r = cli("topic echo /echo_string --count 2 --json --timeout 30");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<json> messages = json_lines(r.out);
+  ASSERT_EQ(messages.size(), 2u) << r.out;
+  for (const json& message : messages) {
+    ASSERT_EQ(message.size(), 1u) << message;
+    EXPECT_TRUE(message.at("data").get<std::string>().starts_with("hello world ")) << message;
+  }
+  const Outcome text = cli("topic echo /echo_string --count 1 --timeout 30");
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_TRUE(text.out.starts_with("data: \"hello world ")) << text.out;
+  EXPECT_TRUE(text.out.ends_with("\"\n---\n")) << text.out;
+}
+
+TEST_F(TopicEchoLive, DeepestStandardTypeAsJsonLines) {
+  SteadyPublisher<visualization_msgs::msg::InteractiveMarkerUpdate> publisher(node_, "/echo_update",
+                                                                              fill_update);
+  const Outcome r = cli("topic echo /echo_update --count 2 --json --timeout 30");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<json> messages = json_lines(r.out);
+  ASSERT_EQ(messages.size(), 2u) << r.out;
+  for (const json& message : messages) {
+    const auto seq = message.at("seq_num").get<std::uint64_t>();
+    EXPECT_EQ(message.at("server_id"), "server");
+    EXPECT_EQ(message.at("type"), 1);
+    EXPECT_EQ(message.at("erases"), json::array({"old"}));
+    const json& marker = message.at("markers").at(0);
+    EXPECT_EQ(marker.at("name"), "handle");
+    EXPECT_EQ(marker.at("scale"), 0.5);
+    EXPECT_EQ(marker.at("pose").at("orientation").at("w"), 1.0);  // the .msg default
+    const json& control = marker.at("controls").at(0);
+    EXPECT_EQ(control.at("name"), "move_x");
+    EXPECT_EQ(control.at("interaction_mode"), 3);
+    const json& shape = control.at("markers").at(0);
+    EXPECT_EQ(shape.at("type"), 10);
+    EXPECT_EQ(shape.at("lifetime").at("sec"), seq);
+    EXPECT_EQ(shape.at("mesh_file").at("filename"), "arrow.stl");
+    EXPECT_EQ(shape.at("mesh_file").at("data"), json::array({1, 2, 3}));
+    EXPECT_EQ(shape.at("texture").at("data"), json::array());
   }
 }
 

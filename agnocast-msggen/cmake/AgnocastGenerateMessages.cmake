@@ -5,7 +5,7 @@
 # an INTERFACE library to link: it carries the include folder, agnocast::agnocast
 # and the targets of the dependencies. The FILES of one package live in one folder.
 # A dependency is a target made by this function, or a package of the standard
-# set (builtin_interfaces, std_msgs, geometry_msgs, sensor_msgs: agnocast::<name>).
+# set (std_msgs, geometry_msgs, sensor_msgs, nav_msgs, ...: agnocast::<name>).
 
 # "PointCloud2" -> "point_cloud2", the rule of agnocast-msggen's snake_case().
 function(_agnocast_snake_case name out)

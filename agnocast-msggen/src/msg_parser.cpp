@@ -225,7 +225,10 @@ class Parser {
     const bool comment_is_value = equals != std::string_view::npos && type.base == BaseType::String;
     if (!comment.empty() && !comment_is_value) comments.emplace_back(comment);
     if (equals != std::string_view::npos) {
-      add_constant(type, trim(rest.substr(0, equals)), line.substr(line.find('=') + 1), comment,
+      // The value starts after the '=' that follows the name: a bounded string
+      // type (string<=N) has one of its own. rest is a view into line.
+      const auto value_at = static_cast<std::size_t>(rest.data() - line.data()) + equals + 1;
+      add_constant(type, trim(rest.substr(0, equals)), line.substr(value_at), comment,
                    std::move(comments), line_number);
       return;
     }

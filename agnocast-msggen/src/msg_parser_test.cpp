@@ -70,6 +70,43 @@ TEST(MsgParser, StringConstantKeepsHashes) {
   EXPECT_EQ(spec.constants[1].initializer, "3");
 }
 
+// ROS 2's common messages declare constants of many types, e.g.
+// diagnostic_msgs/DiagnosticStatus (byte), sensor_msgs/NavSatStatus (int8 < 0, uint16).
+TEST(MsgParser, ConstantsOfEveryPrimitiveType) {
+  const MessageSpec spec = parse(
+      "bool B=True\nbyte Y=255\nchar C=65\nint8 I8 = -128\nuint8 U8=255\nint16 I16=-32768\n"
+      "uint16 U16 =  65535\nint32 I32=-2147483648\nuint32 U32=4294967295\n"
+      "int64 I64=9223372036854775807\nuint64 U64=18446744073709551615\n"
+      "float32 F32=-1.5\nfloat64 F64=1e-3\nstring S='quoted'\nstring<=3 SB=abc\n");
+  const std::vector<std::pair<std::string, std::string>> expected{
+      {"B", "true"},
+      {"Y", "255"},
+      {"C", "65"},
+      {"I8", "-128"},
+      {"U8", "255"},
+      {"I16", "-32768"},
+      {"U16", "65535"},
+      {"I32", "-2147483648"},
+      {"U32", "4294967295u"},
+      {"I64", "9223372036854775807LL"},
+      {"U64", "18446744073709551615ULL"},
+      {"F32", "-1.5F"},
+      {"F64", "0.001"},
+      {"S", "\"quoted\""},
+      {"SB", "\"abc\""}};
+  ASSERT_EQ(spec.constants.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(spec.constants[i].name, expected[i].first);
+    EXPECT_EQ(spec.constants[i].initializer, expected[i].second) << expected[i].first;
+  }
+  EXPECT_EQ(spec.constants[3].type.base, BaseType::Int8);
+  EXPECT_EQ(spec.constants[14].type.string_bound, 3u);
+  EXPECT_EQ(error_of("string<=2 S=abc\n"),
+            "p/msg/M.msg:1: the string has 3 characters, more than its bound 2");
+  EXPECT_EQ(error_of("uint16 S=65536\n"), "p/msg/M.msg:1: 65536 is out of range [0, 65535]");
+  EXPECT_EQ(error_of("int8 S=-129\n"), "p/msg/M.msg:1: -129 is out of range [-128, 127]");
+}
+
 TEST(MsgParser, EmptyMessageGetsThePlaceholderMember) {
   const MessageSpec spec = parse("# nothing\n");
   ASSERT_EQ(spec.fields.size(), 1u);

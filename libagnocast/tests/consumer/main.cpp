@@ -6,6 +6,7 @@
 #include <consumer_msgs/msg/reading.hpp>
 #include <cstdio>
 #include <sensor_msgs/msg/point_cloud2.hpp>
+#include <visualization_msgs/msg/marker_array.hpp>
 
 struct Sample {
   double value = 0;
@@ -37,6 +38,10 @@ int main() {
   const agnocast::Schema schema =
       agnocast::parse_schema(agnocast::schema_of<consumer_msgs::msg::Reading>());
   if (schema.types[0].name != "consumer_msgs/msg/Reading" || schema.types.size() != 4) return 1;
+  if (agnocast::message_traits<visualization_msgs::msg::MarkerArray>::type_name !=
+      "visualization_msgs/msg/MarkerArray") {
+    return 1;
+  }
   std::printf("agnocast %s\n", std::string(agnocast::library_version_string).c_str());
   return 0;
 }

@@ -413,19 +413,30 @@ struct Worker {
            e.entry_id, e.addr);
   }
 
+  // Maps the pools a RECEIVE or TAKE handed over (a garbage step leaves some
+  // out).  A view of the slot's previous pool is replaced or, when the new
+  // one is left out, removed: what it shows is no longer what entries there
+  // hold.  So is this process's own pool when a garbage UNREGISTER let its
+  // slot go to another process.
   void map_pools(const agnocast_pool* pools, uint32_t n, bool always) {
+    std::lock_guard<std::mutex> g(proc->mu);
     for (uint32_t i = 0; i < n; i++) {
-      if (always || chance(80)) {
-        // A stale view of the slot's previous pool is replaced.
-        void* m = mmap(reinterpret_cast<void*>(pools[i].addr), pools[i].size, PROT_READ,
-                       MAP_SHARED | MAP_FIXED, pools[i].fd, 0);
-        std::lock_guard<std::mutex> g(proc->mu);
-        if (m != MAP_FAILED)
-          proc->views[pools[i].addr] = pools[i].size;
-        else
-          proc->views.erase(pools[i].addr);
+      const agnocast_pool& p = pools[i];
+      bool own = proc->reg.map && p.addr == proc->reg.addr;
+      auto it = proc->views.find(p.addr);
+      if (it != proc->views.end()) {
+        if (!own) munmap(reinterpret_cast<void*>(p.addr), it->second);
+        proc->views.erase(it);
       }
-      close(pools[i].fd);
+      if (!own && (always || chance(80))) {
+        void* m = mmap(reinterpret_cast<void*>(p.addr), p.size, PROT_READ,
+                       MAP_SHARED | MAP_FIXED_NOREPLACE, p.fd, 0);
+        if (m == reinterpret_cast<void*>(p.addr))
+          proc->views[p.addr] = p.size;
+        else if (m != MAP_FAILED)
+          munmap(m, p.size);
+      }
+      close(p.fd);
     }
   }
 
@@ -1087,15 +1098,18 @@ bool audit(int dev, const std::vector<pid_t>& workers) {
 void print_table() {
   std::printf("fuzz: %-20s %10s  errors\n", "command", "ok");
   for (int r = 0; r < kRows; r++) {
-    std::string errors;
+    std::printf("fuzz: %-20s %10llu ", kRowNames[r],
+                static_cast<unsigned long long>(sh->count[r][0].load()));
     for (int e = 1; e < kErrnos; e++) {
       uint64_t n = sh->count[r][e];
       if (!n) continue;
       const char* name = strerrorname_np(e);
-      errors += " " + (name ? std::string(name) : std::to_string(e)) + ":" + std::to_string(n);
+      if (name)
+        std::printf(" %s:%llu", name, static_cast<unsigned long long>(n));
+      else
+        std::printf(" %d:%llu", e, static_cast<unsigned long long>(n));
     }
-    std::printf("fuzz: %-20s %10llu %s\n", kRowNames[r],
-                static_cast<unsigned long long>(sh->count[r][0].load()), errors.c_str());
+    std::printf("\n");
   }
 }
 

@@ -249,6 +249,12 @@ struct Process {
   uint64_t seed = 0;
   Registration reg;
   std::shared_mutex pool_lock;
+  // A topic handle outlives its topic only until another topic takes it, and
+  // endpoint ids repeat across topics: a stale endpoint of one topic may thus
+  // act on another.  Adding endpoints (and noting their topic) takes this
+  // exclusively; the commands whose topic is looked up take it shared, so the
+  // handle's topic is the one the kernel acted on.  Taken after pool_lock.
+  std::shared_mutex ep_lock;
   std::mutex mu;  // guards what follows
   std::vector<uint64_t> free_slots;
   std::map<uint64_t, uint64_t> views;  // address -> size of mapped pools, ours included
@@ -478,10 +484,11 @@ struct Worker {
       ep.schema = uptr(kSchema);
       ep.schema_size = wellformed ? sizeof(kSchema) : some_u32(8192);
     }
-    if (call(publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep, topic,
-             flags))
-      return;
     {
+      std::unique_lock<std::shared_mutex> eps(proc->ep_lock);
+      if (call(publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep, topic,
+               flags))
+        return;
       std::lock_guard<std::mutex> g(proc->mu);
       proc->topic_of[ep.topic_handle] = topic;
     }
@@ -519,6 +526,7 @@ struct Worker {
   void do_publish() {
     Ep e = some_endpoint(pubs);
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     agnocast_publish arg{};
     arg.topic_handle = e.handle;
     arg.publisher_id = e.id;
@@ -560,6 +568,7 @@ struct Worker {
       release_ids[i] = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
     arg.release_ids = chance(95) ? uptr(release_ids) : uptr(bad_pointer());
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     if (call(AGNOCAST_IOC_RECEIVE, &arg, e.handle, e.id)) return;
     if (arg.release_count) count(kReceiveReleases, 0);
     if (arg.entry_count) count(kReceiveEntries, 0);
@@ -577,6 +586,7 @@ struct Worker {
     arg.subscriber_id = e.id;
     if (!wellformed && chance(3)) arg.flags = 1;
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     if (call(AGNOCAST_IOC_TAKE, &arg, e.handle, e.id)) return;
     map_pools(&arg.pool, arg.pool_count, wellformed);
     if (!arg.entry_count) return;
@@ -609,6 +619,7 @@ struct Worker {
                         wellformed ? AGNOCAST_RECLAIM_BATCH : static_cast<uint32_t>(rnd(600)), 0, 0,
                         0};
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     if (call(AGNOCAST_IOC_RECLAIM, &rc, rc.reclaim_capacity) || !rc.reclaim_count) return;
     count(kReclaimAddrs, 0);
     uint32_t n = std::min<uint32_t>(rc.reclaim_count, AGNOCAST_RECLAIM_BATCH);
@@ -619,6 +630,7 @@ struct Worker {
   void do_shed() {
     agnocast_shed arg{};
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     if (call(AGNOCAST_IOC_SHED, chance(95) ? static_cast<void*>(&arg) : bad_pointer()) == 0 &&
         arg.shed)
       count(kShedEntries, 0);
@@ -741,6 +753,7 @@ struct Worker {
     if (pubs.empty()) return add_endpoint(true, true);
     Ep& e = pubs[rnd(pubs.size())];
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     uint64_t addr;
     {
       std::lock_guard<std::mutex> g(proc->mu);
@@ -749,7 +762,12 @@ struct Worker {
       addr = proc->free_slots[proc->free_slots.size() - 1 - i];
       proc->free_slots.erase(proc->free_slots.end() - 1 - static_cast<ptrdiff_t>(i));
     }
-    Message m{kMagic, static_cast<uint32_t>(e.topic), e.id, getpid(), 0, ++e.seq, addr, 0};
+    const int topic = proc->topic_for(e.handle);
+    if (topic < 0) {
+      proc->reclaimed(&addr, 1);
+      return;
+    }
+    Message m{kMagic, static_cast<uint32_t>(topic), e.id, getpid(), 0, ++e.seq, addr, 0};
     m.sum = checksum(m);
     std::memcpy(reinterpret_cast<void*>(addr), &m, sizeof(m));
     static thread_local uint32_t wake[AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX];
@@ -763,9 +781,9 @@ struct Worker {
     arg.wake_capacity = AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX;
     arg.reclaim = uptr(reclaim);
     arg.reclaim_capacity = AGNOCAST_RECLAIM_BATCH;
-    publishing() = e.topic + 1;
+    publishing() = topic + 1;
     int ret = call(AGNOCAST_IOC_PUBLISH, &arg, e.handle, addr);
-    if (ret == 0) published(e.handle, e.topic);
+    if (ret == 0) published(e.handle, topic);
     publishing() = 0;
     if (ret) {
       proc->reclaimed(&addr, 1);
@@ -787,6 +805,7 @@ struct Worker {
         released.push_back(h);
     // Read the held messages once more before they go back.
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     std::vector<bool> wrong(released.size());
     for (size_t i = 0; i < released.size(); i++) {
       rel[i] = released[i].entry_id;
@@ -818,10 +837,11 @@ struct Worker {
     if (arg.release_count) count(kReceiveReleases, 0);
     if (arg.entry_count) count(kReceiveEntries, 0);
     map_pools(pools, arg.pool_count, true);
+    const int topic = proc->topic_for(e.handle);
     for (uint32_t i = 0; i < arg.entry_count; i++) {
-      held.push_back({e.handle, e.id, e.topic, ents[i].entry_id, ents[i].addr});
+      held.push_back({e.handle, e.id, topic, ents[i].entry_id, ents[i].addr});
       // Checked once the pools are mapped; kept for the check at release.
-      verify(e.topic, e.handle, e.id, ents[i], false);
+      verify(topic, e.handle, e.id, ents[i], false);
     }
   }
 
@@ -851,6 +871,7 @@ struct Worker {
         released.push_back(h);
     std::vector<uint64_t> ids;
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     bool wrong = false;
     for (const Held& h : released) {
       ids.push_back(h.entry_id);
@@ -869,6 +890,7 @@ struct Worker {
 
   void reregister() {
     std::unique_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::unique_lock<std::shared_mutex> eps(proc->ep_lock);
     std::lock_guard<std::mutex> g(proc->mu);
     count(kUnregister, -ioc0(proc->dev, AGNOCAST_IOC_UNREGISTER_PROCESS));
     sh->ops++;

@@ -23,6 +23,7 @@
 //   interleaving of processes is the scheduler's).
 #include <poll.h>
 #include <pthread.h>
+#include <sys/prctl.h>
 #include <sys/syscall.h>
 
 #include <atomic>
@@ -145,6 +146,8 @@ struct Shared {
   std::atomic<uint64_t> taken[kTakenMax];
   std::atomic<bool> taken_overflow;
   std::atomic<bool> pause;
+  // Events of the world around the commands.
+  std::atomic<uint64_t> forks, device_swaps, members, non_members;
 };
 Shared* sh;
 
@@ -188,6 +191,16 @@ int row_of(unsigned long cmd) {
 }
 
 void count(int row, int err) { sh->count[row][std::min(err, kErrnos - 1)]++; }
+
+// A failure outside the message checks; safe in a fork child (no stdio lock).
+void report(const char* what, int got, uint64_t seed) {
+  sh->failures++;
+  char line[256];
+  int n = std::snprintf(line, sizeof(line), "fuzz: FAIL (worker seed %llu, pid %d): %s (got %s)\n",
+                        static_cast<unsigned long long>(seed), getpid(), what,
+                        got ? strerrorname_np(got) : "0");
+  if (n > 0) (void)!write(1, line, std::min<size_t>(static_cast<size_t>(n), sizeof(line) - 1));
+}
 
 // A well-formed message: what a publisher writes at the start of a slot.
 constexpr uint64_t kMagic = 0x61676e6f66757a7aull;
@@ -888,6 +901,63 @@ struct Worker {
     });
   }
 
+  // The device file goes away under the other thread: its descriptor
+  // number now names a new open file of the device.  Registration belongs to
+  // the process, not the file, so nothing else changes.
+  void swap_device() {
+    int fd = open_device();
+    if (fd < 0) return;  // a worker outside group agnocast cannot reopen it
+    dup2(fd, proc->dev);
+    close(fd);
+    sh->device_swaps++;
+  }
+
+  // A child forked with the device open is a process of its own: not
+  // registered, owner of none of its parent's endpoints or entries.
+  void fork_child() {
+    Ep pub = pubs.empty() ? Ep{} : pubs[0];
+    Ep sub = subs.empty() ? Ep{} : subs[0];
+    uint64_t held_id = held.empty() ? 0 : held[0].entry_id;
+    bool has_held = !held.empty();
+    int dev = proc->dev;
+    uint64_t seed = proc->seed;
+    sh->forks++;
+    pid_t pid = fork();
+    if (pid == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      auto expect = [&](int row, unsigned long cmd, void* arg, const char* what) {
+        int ret = counted_ioctl(row, dev, cmd, arg);
+        if (ret != ESRCH && !(ret == EACCES && row == kAddSubscriber)) report(what, ret, seed);
+      };
+      agnocast_add_endpoint ep = endpoint(kTopics[0], 1);
+      expect(kAddSubscriber, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep,
+             "a fork child, not registered, added a subscriber");
+      if (!pubs.empty()) {
+        agnocast_publish arg{};
+        arg.topic_handle = pub.handle;
+        arg.publisher_id = pub.id;
+        arg.addr = proc->reg.addr;
+        arg.wake_ids = uptr(arena.base);
+        arg.wake_capacity = 1;
+        expect(kPublish, AGNOCAST_IOC_PUBLISH, &arg,
+               "a fork child published on its parent's publisher");
+      }
+      if (has_held) {
+        agnocast_release rel{sub.handle, sub.id, uptr(&held_id), 1, 0};
+        expect(kRelease, AGNOCAST_IOC_RELEASE, &rel, "a fork child released its parent's entry");
+      }
+      // Registering and leaving without a word: the kernel cleans up.
+      agnocast_register_process reg{};
+      reg.pool_fd = -1;
+      if (counted_ioctl(kRegister, dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg) == 0) {
+        agnocast_add_endpoint ep2 = endpoint(kTopics[rnd(kNumTopics)], 1 + rnd(4));
+        counted_ioctl(kAddPublisher, dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep2);
+      }
+      _exit(0);
+    }
+    if (pid > 0) waitpid(pid, nullptr, 0);
+  }
+
   void reregister() {
     std::unique_lock<std::shared_mutex> lock(proc->pool_lock);
     std::unique_lock<std::shared_mutex> eps(proc->ep_lock);
@@ -955,7 +1025,9 @@ struct Worker {
       case 2:
         // Only the main thread re-registers; the other one may briefly use
         // a stale pool address, which the kernel must refuse cleanly.
-        if (owns_registration && chance(2)) reregister();
+        if (owns_registration && chance(2)) return reregister();
+        if (chance(2)) return swap_device();
+        if (owns_registration && chance(2)) return fork_child();
         return;
       case 3:
         return add_endpoint(true, false);
@@ -1014,9 +1086,26 @@ void* thread_main(void* p) {
 [[noreturn]] void worker_process(int slot, uint64_t seed) {
   sh->slots[slot].pid = getpid();
   auto* proc = new Process;
-  proc->dev = open_device();
   proc->slot = slot;
   proc->seed = seed;
+  // Mostly root; some are nobody in group agnocast, who may open the device;
+  // some are nobody outside it, who may not, but use a descriptor root opened
+  // for them (a descriptor carries its opener's rights).
+  proc->dev = open_device();
+  if (seed % 8 == 5) {
+    close(proc->dev);
+    if (!become(kNobody, kNobody, {kAgnocastGroup})) report("could not become nobody", errno, seed);
+    proc->dev = open_device();
+    if (proc->dev < 0) report("a member of group agnocast could not open the device", errno, seed);
+    sh->members++;
+  } else if (seed % 8 == 6) {
+    if (!become(kNobody, kNobody, {})) report("could not become nobody", errno, seed);
+    int fd = open_device();
+    if (fd >= 0 || errno != EACCES)
+      report("a process outside group agnocast opened the device", fd >= 0 ? 0 : errno, seed);
+    if (fd >= 0) close(fd);
+    sh->non_members++;
+  }
   std::mt19937_64 rng(seed);
   if (rng() % 10) Worker::register_process(proc, rng() % 10 != 0);
   proc->reset_pool();
@@ -1234,7 +1323,9 @@ int main(int argc, char** argv) {
   std::printf(
       "fuzz: %llu operations in %.1f s, %llu worker processes, %zu exit records\n"
       "fuzz: messages checked: %llu on receipt, %llu again at release, %llu unreadable\n"
-      "fuzz: %llu audits (%llu subscriber counts checked, %llu audits skipped)%s\n",
+      "fuzz: %llu audits (%llu subscriber counts checked, %llu audits skipped)%s\n"
+      "fuzz: %llu forks with the device open, %llu device files replaced in use, %llu workers "
+      "as a member of group agnocast, %llu as a non-member\n",
       static_cast<unsigned long long>(sh->ops.load()), static_cast<double>(elapsed.count()) / 1000,
       static_cast<unsigned long long>(spawned), records,
       static_cast<unsigned long long>(sh->verified.load()),
@@ -1242,7 +1333,11 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(sh->unverifiable.load()),
       static_cast<unsigned long long>(audits), static_cast<unsigned long long>(audit_checks),
       static_cast<unsigned long long>(audits_skipped),
-      sh->taken_overflow ? " (took: inequalities only)" : "");
+      sh->taken_overflow ? " (took: inequalities only)" : "",
+      static_cast<unsigned long long>(sh->forks.load()),
+      static_cast<unsigned long long>(sh->device_swaps.load()),
+      static_cast<unsigned long long>(sh->members.load()),
+      static_cast<unsigned long long>(sh->non_members.load()));
   for (int r = 0; r < kRows; r++) {
     if (r == kUnknown || sh->count[r][0]) continue;
     std::printf("fuzz: FAIL: %s never succeeded\n", kRowNames[r]);

@@ -1,9 +1,13 @@
 // Randomized ioctl fuzzer: several processes, two threads each, issue
 // commands for a bounded time; the parent kills and respawns workers at
-// random.  A share of the steps are garbage (random commands, arguments and
-// bad pointers), a share are well-formed and stateful (a pool allocator,
-// tagged messages, receives that release what they hold), so that every
-// command's success path is reached.  Checked while it runs:
+// random.  Around the commands: workers as nobody in and outside group
+// agnocast, children forked with the device open (which must own nothing),
+// the device file replaced under a thread using it, workers that exec,
+// access policies set and removed.  A share of the steps are garbage
+// (random commands, arguments and bad pointers), a share well-formed and
+// stateful (a pool allocator, tagged messages, receives that release what
+// they hold), so that every command's success path is reached.  Checked
+// while it runs:
 //  - every message a subscriber reads carries the tag its publisher wrote:
 //    the subscriber's topic, the entry's publisher and address, a checksum;
 //    it is read again, unchanged, when the subscriber releases it;
@@ -147,9 +151,10 @@ struct Shared {
   std::atomic<bool> taken_overflow;
   std::atomic<bool> pause;
   // Events of the world around the commands.
-  std::atomic<uint64_t> forks, device_swaps, members, non_members;
+  std::atomic<uint64_t> forks, device_swaps, members, non_members, execs;
 };
 Shared* sh;
+int shared_fd = -1;  // sh's memfd, kept across exec
 
 void mark_taken(int topic, uint32_t id) {
   uint64_t key = (static_cast<uint64_t>(topic) + 1) << 32 | id;
@@ -958,6 +963,22 @@ struct Worker {
     if (pid > 0) waitpid(pid, nullptr, 0);
   }
 
+  // The worker execs a new worker image in place (same pid): the kernel
+  // drops what the old image held.  Outside group agnocast it could not
+  // reopen the device, so it does not.
+  void exec_self() {
+    if (proc->seed % 8 == 6) return;
+    char slot[16], seed[32], fd[16];
+    std::snprintf(slot, sizeof(slot), "%d", proc->slot);
+    std::snprintf(seed, sizeof(seed), "%llu",
+                  static_cast<unsigned long long>(proc->seed * 0x9E3779B97F4A7C15ull + 7));
+    std::snprintf(fd, sizeof(fd), "%d", shared_fd);
+    sh->execs++;
+    execl("/proc/self/exe", "agnocast_fuzz_test", "--worker", slot, seed, fd,
+          static_cast<char*>(nullptr));
+    sh->execs--;
+  }
+
   void reregister() {
     std::unique_lock<std::shared_mutex> lock(proc->pool_lock);
     std::unique_lock<std::shared_mutex> eps(proc->ep_lock);
@@ -1028,6 +1049,7 @@ struct Worker {
         if (owns_registration && chance(2)) return reregister();
         if (chance(2)) return swap_device();
         if (owns_registration && chance(2)) return fork_child();
+        if (owns_registration && chance(1)) return exec_self();
         return;
       case 3:
         return add_endpoint(true, false);
@@ -1082,17 +1104,13 @@ void* thread_main(void* p) {
   return nullptr;
 }
 
-// A worker process: registers (usually), then two threads fuzz until killed.
-[[noreturn]] void worker_process(int slot, uint64_t seed) {
-  sh->slots[slot].pid = getpid();
-  auto* proc = new Process;
-  proc->slot = slot;
-  proc->seed = seed;
-  // Mostly root; some are nobody in group agnocast, who may open the device;
-  // some are nobody outside it, who may not, but use a descriptor root opened
-  // for them (a descriptor carries its opener's rights).
-  proc->dev = open_device();
-  if (seed % 8 == 5) {
+// Mostly root; some are nobody in group agnocast, who may open the device;
+// some are nobody outside it, who may not, but use a descriptor root opened
+// for them (a descriptor carries its opener's rights).
+void identity(Process* proc, uint64_t seed) {
+  if ((proc->dev = open_device()) < 0) {
+    report("root could not open the device", errno, seed);
+  } else if (seed % 8 == 5) {
     close(proc->dev);
     if (!become(kNobody, kNobody, {kAgnocastGroup})) report("could not become nobody", errno, seed);
     proc->dev = open_device();
@@ -1105,6 +1123,26 @@ void* thread_main(void* p) {
       report("a process outside group agnocast opened the device", fd >= 0 ? 0 : errno, seed);
     if (fd >= 0) close(fd);
     sh->non_members++;
+  }
+}
+
+// A worker process: registers (usually), then two threads fuzz until killed.
+[[noreturn]] void worker_process(int slot, uint64_t seed, bool execed) {
+  sh->slots[slot].pid = getpid();
+  auto* proc = new Process;
+  proc->slot = slot;
+  proc->seed = seed;
+  if (execed) {
+    // The old image's other thread died anywhere, maybe mid-publish; its
+    // pause is void.  Its registration must go, soon.
+    settle_slot(slot);
+    make_uncertain(-1);
+    sh->slots[slot].paused = 0;
+    proc->dev = open_device();
+    if (!eventually([&] { return !process_listed(proc->dev, getpid()); }))
+      report("a process that exec'd is still registered", 0, seed);
+  } else {
+    identity(proc, seed);
   }
   std::mt19937_64 rng(seed);
   if (rng() % 10) Worker::register_process(proc, rng() % 10 != 0);
@@ -1227,6 +1265,14 @@ void print_table() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A worker that exec'd: agnocast_fuzz_test --worker SLOT SEED SHARED_FD.
+  if (argc == 5 && std::string(argv[1]) == "--worker") {
+    shared_fd = std::atoi(argv[4]);
+    sh = static_cast<Shared*>(
+        mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
+    if (sh == MAP_FAILED) return 2;
+    worker_process(std::atoi(argv[2]), std::strtoull(argv[3], nullptr, 10), true);
+  }
   int seconds = -1, nprocs = 6;
   long long min_ops = -1;
   bool long_mode = std::getenv("AGNOCAST_FUZZ_LONG") != nullptr;
@@ -1256,8 +1302,10 @@ int main(int argc, char** argv) {
               min_ops, nprocs, static_cast<unsigned long long>(base_seed));
   std::fflush(stdout);
 
+  shared_fd = memfd_create("agnocast-fuzz", 0);
+  if (shared_fd < 0 || ftruncate(shared_fd, sizeof(Shared))) return 2;
   sh = static_cast<Shared*>(
-      mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0));
+      mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
   std::mt19937_64 rng(base_seed);
   std::vector<pid_t> workers(nprocs);
   uint64_t spawned = 0;
@@ -1267,7 +1315,7 @@ int main(int argc, char** argv) {
     for (auto& p : sh->slots[i].published) p = 0;
     sh->slots[i].pid = 0;
     pid_t pid = fork();
-    if (pid == 0) worker_process(i, seed);
+    if (pid == 0) worker_process(i, seed, false);
     sh->slots[i].pid = pid;
     workers[i] = pid;
   };
@@ -1325,7 +1373,7 @@ int main(int argc, char** argv) {
       "fuzz: messages checked: %llu on receipt, %llu again at release, %llu unreadable\n"
       "fuzz: %llu audits (%llu subscriber counts checked, %llu audits skipped)%s\n"
       "fuzz: %llu forks with the device open, %llu device files replaced in use, %llu workers "
-      "as a member of group agnocast, %llu as a non-member\n",
+      "as a member of group agnocast, %llu as a non-member, %llu execs\n",
       static_cast<unsigned long long>(sh->ops.load()), static_cast<double>(elapsed.count()) / 1000,
       static_cast<unsigned long long>(spawned), records,
       static_cast<unsigned long long>(sh->verified.load()),
@@ -1337,7 +1385,8 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(sh->forks.load()),
       static_cast<unsigned long long>(sh->device_swaps.load()),
       static_cast<unsigned long long>(sh->members.load()),
-      static_cast<unsigned long long>(sh->non_members.load()));
+      static_cast<unsigned long long>(sh->non_members.load()),
+      static_cast<unsigned long long>(sh->execs.load()));
   for (int r = 0; r < kRows; r++) {
     if (r == kUnknown || sh->count[r][0]) continue;
     std::printf("fuzz: FAIL: %s never succeeded\n", kRowNames[r]);

@@ -1046,7 +1046,7 @@ struct Worker {
       case 2:
         // Only the main thread re-registers; the other one may briefly use
         // a stale pool address, which the kernel must refuse cleanly.
-        if (owns_registration && chance(2)) return reregister();
+        if (owns_registration && chance(10)) return reregister();
         if (chance(2)) return swap_device();
         if (owns_registration && chance(2)) return fork_child();
         if (owns_registration && chance(1)) return exec_self();
@@ -1156,7 +1156,7 @@ void identity(Process* proc, uint64_t seed) {
     a->step();
     // Some workers end on their own, with or without unregistering.
     if (i == 5000 && seed % 3 == 0) {
-      if (seed % 2) ioc0(proc->dev, AGNOCAST_IOC_UNREGISTER_PROCESS);
+      if (seed % 2) counted_ioctl(kUnregister, proc->dev, AGNOCAST_IOC_UNREGISTER_PROCESS, nullptr);
       _exit(0);
     }
   }

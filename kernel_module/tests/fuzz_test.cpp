@@ -1,16 +1,42 @@
-// Randomized ioctl fuzzer: several processes, two threads each, issue random
-// commands with random, garbage or bad-pointer arguments for a bounded time;
-// the parent kills and respawns workers at random.  Afterwards every process
-// must be torn down and every topic gone.  The VM bed checks the kernel log.
+// Randomized ioctl fuzzer: several processes, two threads each, issue
+// commands for a bounded time; the parent kills and respawns workers at
+// random.  Around the commands: workers as nobody in and outside group
+// agnocast, children forked with the device open (which must own nothing),
+// the device file replaced under a thread using it, workers that exec,
+// access policies set and removed.  A share of the steps are garbage
+// (random commands, arguments and bad pointers), a share well-formed and
+// stateful (a pool allocator, tagged messages, receives that release what
+// they hold), so that every command's success path is reached.  Checked
+// while it runs:
+//  - every message a subscriber reads carries the tag its publisher wrote:
+//    the subscriber's topic, the entry's publisher and address, a checksum;
+//    it is read again, unchanged, when the subscriber releases it;
+//  - at pauses of every worker, each subscriber's received + unreceived +
+//    dropped (the kernel's counters, from TOPIC_INFO) grew by exactly the
+//    number of messages published on its topic meanwhile (TAKE passes older
+//    entries over uncounted: at most that many for subscribers that took);
+// and at the end that every process and topic is gone.  It prints, per
+// command, successes and each errno, and fails if a command never succeeded.
+// A failure prints the seed and the last operations of the thread that saw
+// it.  The VM bed checks the kernel log.
 //
-// usage: agnocast_fuzz_test [SECONDS] [PROCESSES]
+// usage: agnocast_fuzz_test [SECONDS [PROCESSES]] [--ops N] [--seed S] [--long]
+//   Runs SECONDS (default 30) and on until N operations (default 0) were
+//   issued.  --long: 4 hours and 10^6 operations, unless given otherwise.
+//   --seed replays the workers' random choices of an earlier run (the
+//   interleaving of processes is the scheduler's).
 #include <poll.h>
 #include <pthread.h>
+#include <sys/prctl.h>
 #include <sys/syscall.h>
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <mutex>
 #include <random>
+#include <shared_mutex>
 
 #include "test_util.h"
 
@@ -18,7 +44,64 @@ using namespace agnocast_test;
 
 namespace {
 
-const unsigned long kCommands[] = {
+// Rows of the reach table: every command of the UAPI, then outcomes that
+// matter beyond a bare success.
+enum Row : int {
+  kGetVersion,
+  kRegister,
+  kUnregister,
+  kAddPublisher,
+  kRemovePublisher,
+  kAddSubscriber,
+  kRemoveSubscriber,
+  kPublish,
+  kReclaim,
+  kReceive,
+  kTake,
+  kRelease,
+  kListTopics,
+  kTopicInfo,
+  kListProcesses,
+  kShed,
+  kSetPolicy,
+  kGetPolicy,
+  kTopicSchema,
+  kUnknown,
+  kReceiveEntries,   // RECEIVE that returned entries
+  kReceiveReleases,  // RECEIVE that released entries
+  kTakeEntry,        // TAKE that returned an entry
+  kPublishReclaim,   // PUBLISH that returned reclaimable addresses
+  kReclaimAddrs,     // RECLAIM that returned addresses
+  kShedEntries,      // SHED that took entries
+  kRows
+};
+const char* const kRowNames[kRows] = {"GET_VERSION",
+                                      "REGISTER_PROCESS",
+                                      "UNREGISTER_PROCESS",
+                                      "ADD_PUBLISHER",
+                                      "REMOVE_PUBLISHER",
+                                      "ADD_SUBSCRIBER",
+                                      "REMOVE_SUBSCRIBER",
+                                      "PUBLISH",
+                                      "RECLAIM",
+                                      "RECEIVE",
+                                      "TAKE",
+                                      "RELEASE",
+                                      "LIST_TOPICS",
+                                      "TOPIC_INFO",
+                                      "LIST_PROCESSES",
+                                      "SHED",
+                                      "SET_POLICY",
+                                      "GET_POLICY",
+                                      "TOPIC_SCHEMA",
+                                      "(unknown command)",
+                                      " RECEIVE entries",
+                                      " RECEIVE releases",
+                                      " TAKE entry",
+                                      " PUBLISH reclaim",
+                                      " RECLAIM addrs",
+                                      " SHED entries"};
+const unsigned long kCommands[kUnknown] = {
     AGNOCAST_IOC_GET_VERSION,
     AGNOCAST_IOC_REGISTER_PROCESS,
     AGNOCAST_IOC_UNREGISTER_PROCESS,
@@ -34,8 +117,121 @@ const unsigned long kCommands[] = {
     AGNOCAST_IOC_LIST_TOPICS,
     AGNOCAST_IOC_TOPIC_INFO,
     AGNOCAST_IOC_LIST_PROCESSES,
+    AGNOCAST_IOC_SHED,
+    AGNOCAST_IOC_SET_POLICY,
+    AGNOCAST_IOC_GET_POLICY,
+    AGNOCAST_IOC_TOPIC_SCHEMA,
 };
+constexpr int kErrnos = 134;  // errno values counted one by one; larger ones share the last
 const char* const kTopics[] = {"/a", "/a/b", "/a_b", "/chatter", "/x/y/z", "/x_y/z", "/q"};
+constexpr int kNumTopics = static_cast<int>(std::size(kTopics));
+constexpr int kMaxProcs = 64;
+constexpr int kTakenMax = 8192;
+
+// Shared by the parent and every worker (an anonymous shared mapping).
+struct Shared {
+  std::atomic<uint64_t> count[kRows][kErrnos];
+  std::atomic<uint64_t> ops;
+  std::atomic<uint64_t> failures;
+  std::atomic<uint64_t> verified, rechecked, unverifiable;
+  // Successful PUBLISHes per topic, in total and per worker slot.
+  std::atomic<uint64_t> published[kNumTopics];
+  // Bumped when a topic's count may have missed a publish: a worker died
+  // between its PUBLISH and the count.  Audits then start that topic afresh.
+  std::atomic<uint64_t> uncertain[kNumTopics];
+  struct Slot {
+    std::atomic<int> pid;
+    std::atomic<int> paused;
+    // Per thread: 1 + the topic of a PUBLISH under way (kNumTopics + 1: unknown).
+    std::atomic<int> publishing[2];
+    std::atomic<uint64_t> published[kNumTopics];
+  } slots[kMaxProcs];
+  // Subscribers (topic index + 1) << 32 | id that a TAKE returned an entry
+  // to since the last audit.
+  std::atomic<uint64_t> taken[kTakenMax];
+  std::atomic<bool> taken_overflow;
+  std::atomic<bool> pause;
+  // Events of the world around the commands.
+  std::atomic<uint64_t> forks, device_swaps, members, non_members, execs;
+};
+Shared* sh;
+int shared_fd = -1;  // sh's memfd, kept across exec
+
+void mark_taken(int topic, uint32_t id) {
+  uint64_t key = (static_cast<uint64_t>(topic) + 1) << 32 | id;
+  for (uint64_t i = 0, h = key * 0x9E3779B97F4A7C15ull >> 51; i < kTakenMax; i++) {
+    auto& slot = sh->taken[(h + i) % kTakenMax];
+    uint64_t cur = 0;
+    if (slot.compare_exchange_strong(cur, key) || cur == key) return;
+  }
+  sh->taken_overflow = true;
+}
+
+bool was_taken(int topic, uint32_t id) {
+  uint64_t key = (static_cast<uint64_t>(topic) + 1) << 32 | id;
+  for (uint64_t i = 0, h = key * 0x9E3779B97F4A7C15ull >> 51; i < kTakenMax; i++) {
+    uint64_t cur = sh->taken[(h + i) % kTakenMax].load();
+    if (cur == key) return true;
+    if (cur == 0) return false;
+  }
+  return true;
+}
+
+void make_uncertain(int topic) {
+  for (int t = 0; t < kNumTopics; t++)
+    if (topic < 0 || topic == t) sh->uncertain[t]++;
+}
+
+// A dead worker's publishes under way may have happened uncounted.
+void settle_slot(int slot) {
+  for (auto& p : sh->slots[slot].publishing) {
+    int v = p.exchange(0);
+    if (v) make_uncertain(v <= kNumTopics ? v - 1 : -1);
+  }
+}
+
+int row_of(unsigned long cmd) {
+  for (int i = 0; i < kUnknown; i++)
+    if (kCommands[i] == cmd) return i;
+  return kUnknown;
+}
+
+void count(int row, int err) { sh->count[row][std::min(err, kErrnos - 1)]++; }
+
+// A failure outside the message checks; safe in a fork child (no stdio lock).
+void report(const char* what, int got, uint64_t seed) {
+  sh->failures++;
+  char line[256];
+  int n = std::snprintf(line, sizeof(line), "fuzz: FAIL (worker seed %llu, pid %d): %s (got %s)\n",
+                        static_cast<unsigned long long>(seed), getpid(), what,
+                        got ? strerrorname_np(got) : "0");
+  if (n > 0) (void)!write(1, line, std::min<size_t>(static_cast<size_t>(n), sizeof(line) - 1));
+}
+
+// A well-formed message: what a publisher writes at the start of a slot.
+constexpr uint64_t kMagic = 0x61676e6f66757a7aull;
+constexpr uint64_t kSlotBytes = 256;
+constexpr uint64_t kSlots = 512;
+struct Message {
+  uint64_t magic;
+  uint32_t topic;
+  uint32_t publisher_id;
+  int32_t pid;
+  uint32_t pad;
+  uint64_t seq;
+  uint64_t addr;
+  uint64_t sum;
+};
+uint64_t checksum(const Message& m) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (uint64_t v : {m.magic, uint64_t{m.topic}, uint64_t{m.publisher_id},
+                     static_cast<uint64_t>(static_cast<uint32_t>(m.pid)), m.seq, m.addr}) {
+    h ^= v;
+    h *= 0x100000001b3ull;
+    h ^= h >> 29;
+  }
+  return h;
+}
 
 // A page of scratch memory followed by an inaccessible page, so that
 // arguments can straddle into a fault.
@@ -48,17 +244,119 @@ struct Arena {
   }
 };
 
+struct Ep {
+  uint32_t handle = 0;
+  uint32_t id = 0;
+  int topic = -1;
+  uint32_t flags = 0;
+  uint64_t seq = 0;
+};
+
+struct Held {
+  uint32_t handle, sub_id;
+  int topic;
+  uint64_t entry_id, addr;
+};
+
+// What both threads of a worker process share: the registration, its pool
+// allocator, the views of other pools and the topic of each handle.  Pool
+// memory is touched, and ioctls that can hand back pool addresses issued,
+// under the shared lock; re-registering takes it exclusively.
+struct Process {
+  int dev = -1;
+  int slot = 0;
+  uint64_t seed = 0;
+  Registration reg;
+  std::shared_mutex pool_lock;
+  // A topic handle outlives its topic only until another topic takes it, and
+  // endpoint ids repeat across topics: a stale endpoint of one topic may thus
+  // act on another.  Adding endpoints (and noting their topic) takes this
+  // exclusively; the commands whose topic is looked up take it shared, so the
+  // handle's topic is the one the kernel acted on.  Taken after pool_lock.
+  std::shared_mutex ep_lock;
+  std::mutex mu;  // guards what follows
+  std::vector<uint64_t> free_slots;
+  std::map<uint64_t, uint64_t> views;  // address -> size of mapped pools, ours included
+  std::map<uint32_t, int> topic_of;    // topic handle -> topic index
+
+  void reset_pool() {
+    free_slots.clear();
+    views.clear();
+    if (reg.map) {
+      for (uint64_t i = kSlots; i-- > 0;) free_slots.push_back(reg.addr + i * kSlotBytes);
+      views[reg.addr] = reg.size;
+    }
+  }
+  void reclaimed(const uint64_t* addrs, uint32_t n) {
+    std::lock_guard<std::mutex> g(mu);
+    for (uint32_t i = 0; i < n; i++) {
+      uint64_t a = addrs[i];
+      if (reg.map && a >= reg.addr && a < reg.addr + kSlots * kSlotBytes &&
+          (a - reg.addr) % kSlotBytes == 0)
+        free_slots.push_back(a);
+    }
+  }
+  int topic_for(uint32_t handle) {
+    std::lock_guard<std::mutex> g(mu);
+    auto it = topic_of.find(handle);
+    return it == topic_of.end() ? -1 : it->second;
+  }
+};
+
+struct OpRecord {
+  int row;
+  int result;
+  uint64_t a, b;
+};
+
+int counted_ioctl(int row, int dev, unsigned long cmd, void* arg) {
+  int ret = ioctl(dev, cmd, arg) == 0 ? 0 : errno;
+  count(row, ret);
+  sh->ops++;
+  return ret;
+}
+
 struct Worker {
+  Worker(uint64_t seed, Process* p, bool owner) : rng(seed), proc(p), owns_registration(owner) {}
   std::mt19937_64 rng;
-  int dev;
-  Registration* reg;
+  Process* proc;
   bool owns_registration;
   Arena arena;
-  std::vector<Endpoint> pubs, subs;
-  std::vector<uint64_t> entries;
+  std::vector<Ep> pubs, subs;
+  std::vector<Held> held;
+  std::vector<uint64_t> entries;  // ids for garbage releases
+  OpRecord ring[64] = {};
+  uint64_t nops = 0;
+  bool reported = false;
 
   uint64_t rnd(uint64_t n) { return n ? rng() % n : 0; }
   bool chance(int percent) { return rnd(100) < static_cast<uint64_t>(percent); }
+  int dev() const { return proc->dev; }
+
+  int call(unsigned long cmd, void* arg, uint64_t a = 0, uint64_t b = 0) {
+    int row = row_of(cmd);
+    int ret = counted_ioctl(row, dev(), cmd, arg);
+    ring[nops++ % std::size(ring)] = {row, ret, a, b};
+    return ret;
+  }
+
+  void fail(const char* what, uint64_t entry_id, uint64_t addr) {
+    sh->failures++;
+    if (reported) return;
+    reported = true;
+    std::printf("fuzz: FAIL (worker seed %llu, pid %d): %s: entry %llu at 0x%llx\n",
+                static_cast<unsigned long long>(proc->seed), getpid(), what,
+                static_cast<unsigned long long>(entry_id), static_cast<unsigned long long>(addr));
+    std::printf("fuzz: the last operations of this thread, oldest first:\n");
+    uint64_t n = std::min<uint64_t>(nops, std::size(ring));
+    for (uint64_t i = nops - n; i < nops; i++) {
+      const OpRecord& r = ring[i % std::size(ring)];
+      std::printf("  %-18s 0x%llx 0x%llx -> %s\n", kRowNames[r.row],
+                  static_cast<unsigned long long>(r.a), static_cast<unsigned long long>(r.b),
+                  r.result ? strerrorname_np(r.result) : "0");
+    }
+    std::fflush(stdout);
+  }
 
   void* bad_pointer() {
     switch (rnd(5)) {
@@ -93,15 +391,91 @@ struct Worker {
     }
   }
 
-  Endpoint some_endpoint(const std::vector<Endpoint>& v) {
+  Ep some_endpoint(const std::vector<Ep>& v) {
     if (v.empty() || chance(15)) return {some_u32(8), some_u32(8)};
     return v[rnd(v.size())];
   }
+
+  // --- Reading messages -------------------------------------------------
+
+  // Checks the message of a held entry; false only on a wrong message.
+  // Entries of pools this process has no view of cannot be read.
+  bool message_ok(int topic, const agnocast_entry& e, bool* read) {
+    std::lock_guard<std::mutex> g(proc->mu);
+    *read = false;
+    auto it = proc->views.upper_bound(e.addr);
+    if (it == proc->views.begin()) return true;
+    --it;
+    if (e.addr + sizeof(Message) > it->first + it->second) return true;
+    // Only well-formed publishes use slot-aligned addresses.
+    if ((e.addr - it->first) % kSlotBytes) return true;
+    Message m;
+    std::memcpy(&m, reinterpret_cast<const void*>(e.addr), sizeof(m));
+    *read = true;
+    return m.magic == kMagic && m.sum == checksum(m) && m.addr == e.addr &&
+           static_cast<int>(m.topic) == topic && m.publisher_id == e.publisher_id;
+  }
+
+  // A wrong message counts only if the entry was held all along: another
+  // thread may have released it (a garbage RELEASE may name any id) and its
+  // publisher reused the memory.  Releasing it now tells: a held entry is
+  // never held again once released.
+  void verify(int topic, uint32_t handle, uint32_t sub_id, const agnocast_entry& e, bool recheck) {
+    if (topic < 0) return;
+    bool read;
+    if (message_ok(topic, e, &read)) {
+      if (read)
+        (recheck ? sh->rechecked : sh->verified)++;
+      else
+        sh->unverifiable++;
+      return;
+    }
+    uint64_t id = e.entry_id;
+    agnocast_release rel{handle, sub_id, uptr(&id), 1, 0};
+    if (call(AGNOCAST_IOC_RELEASE, &rel, handle, id) == 0)
+      fail(recheck ? "a held message changed before its release"
+                   : "a received message is not one published on the subscriber's topic",
+           e.entry_id, e.addr);
+  }
+
+  // Maps the pools a RECEIVE or TAKE handed over (a garbage step leaves some
+  // out).  A view of the slot's previous pool is replaced or, when the new
+  // one is left out, removed: what it shows is no longer what entries there
+  // hold.  So is this process's own pool when a garbage UNREGISTER let its
+  // slot go to another process.
+  void map_pools(const agnocast_pool* pools, uint32_t n, bool always) {
+    std::lock_guard<std::mutex> g(proc->mu);
+    for (uint32_t i = 0; i < n; i++) {
+      const agnocast_pool& p = pools[i];
+      bool own = proc->reg.map && p.addr == proc->reg.addr;
+      auto it = proc->views.find(p.addr);
+      if (it != proc->views.end()) {
+        if (!own) munmap(reinterpret_cast<void*>(p.addr), it->second);
+        proc->views.erase(it);
+      }
+      if (!own && (always || chance(80))) {
+        void* m = mmap(reinterpret_cast<void*>(p.addr), p.size, PROT_READ,
+                       MAP_SHARED | MAP_FIXED_NOREPLACE, p.fd, 0);
+        if (m == reinterpret_cast<void*>(p.addr))
+          proc->views[p.addr] = p.size;
+        else if (m != MAP_FAILED)
+          munmap(m, p.size);
+      }
+      close(p.fd);
+    }
+  }
+
+  // --- Garbage ----------------------------------------------------------
 
   void garbage() {
     unsigned long cmd = kCommands[rnd(std::size(kCommands))];
     if (chance(10)) cmd = static_cast<unsigned long>(rng());
     if (chance(10)) cmd ^= 1ul << rnd(32);
+    // Not these: they would unregister or hand out pools behind the
+    // bookkeeping's back.
+    if ((cmd == AGNOCAST_IOC_UNREGISTER_PROCESS || cmd == AGNOCAST_IOC_REGISTER_PROCESS) &&
+        !chance(10))
+      return;
     void* arg;
     if (chance(40)) {
       arg = bad_pointer();
@@ -109,54 +483,94 @@ struct Worker {
       for (int i = 0; i < 4096; i += 8) *reinterpret_cast<uint64_t*>(arena.base + i) = rng();
       arg = arena.base + rnd(512);
     }
-    ioctl(dev, cmd, arg);
+    // A garbage PUBLISH that succeeds is of an unknown topic.
+    bool pub = cmd == AGNOCAST_IOC_PUBLISH;
+    if (pub) publishing() = kNumTopics + 1;
+    if (call(cmd, arg, uptr(arg)) == 0 && pub) make_uncertain(-1);
+    if (pub) publishing() = 0;
   }
 
-  void add_endpoint(bool publisher) {
-    auto ep = endpoint(kTopics[rnd(std::size(kTopics))], 1 + rnd(chance(5) ? 1100 : 8),
-                       static_cast<uint32_t>(rnd(chance(5) ? 16 : 4)));
-    if (chance(5)) ep.node[rnd(sizeof(ep.node))] = static_cast<char>(rng());
-    if (ioc(dev, publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep)) return;
-    (publisher ? pubs : subs).push_back({ep.topic_handle, ep.id});
+  void add_endpoint(bool publisher, bool wellformed) {
+    int topic = static_cast<int>(rnd(kNumTopics));
+    uint32_t flags = static_cast<uint32_t>(rnd(4));
+    if (!publisher && wellformed) flags = static_cast<uint32_t>(rnd(8));
+    if (!wellformed && chance(5)) flags = static_cast<uint32_t>(rnd(16));
+    auto ep = endpoint(kTopics[topic], 1 + rnd(!wellformed && chance(5) ? 1100 : 8), flags);
+    if (!wellformed && chance(5)) ep.node[rnd(sizeof(ep.node))] = static_cast<char>(rng());
+    // Some bring the topic's schema (the first to do so sets it).
+    static const char kSchema[] = "fuzz message: magic, topic, publisher, pid, seq, addr, sum";
+    if (chance(20)) {
+      ep.schema = uptr(kSchema);
+      ep.schema_size = wellformed ? sizeof(kSchema) : some_u32(8192);
+    }
+    {
+      std::unique_lock<std::shared_mutex> eps(proc->ep_lock);
+      if (call(publisher ? AGNOCAST_IOC_ADD_PUBLISHER : AGNOCAST_IOC_ADD_SUBSCRIBER, &ep, topic,
+               flags))
+        return;
+      std::lock_guard<std::mutex> g(proc->mu);
+      proc->topic_of[ep.topic_handle] = topic;
+    }
+    (publisher ? pubs : subs).push_back({ep.topic_handle, ep.id, topic, ep.flags, 0});
   }
 
   void remove_endpoint(bool publisher) {
     auto& v = publisher ? pubs : subs;
-    Endpoint e = some_endpoint(v);
+    Ep e = some_endpoint(v);
     agnocast_remove_endpoint rm{e.handle, e.id};
-    if (ioc(dev, publisher ? AGNOCAST_IOC_REMOVE_PUBLISHER : AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm) ==
-        0)
-      std::erase_if(v, [&](const Endpoint& x) { return x.handle == e.handle && x.id == e.id; });
+    if (call(publisher ? AGNOCAST_IOC_REMOVE_PUBLISHER : AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm,
+             e.handle, e.id) == 0) {
+      std::erase_if(v, [&](const Ep& x) { return x.handle == e.handle && x.id == e.id; });
+      if (!publisher)
+        std::erase_if(held,
+                      [&](const Held& h) { return h.handle == e.handle && h.sub_id == e.id; });
+    }
+  }
+
+  std::atomic<int>& publishing() {
+    return sh->slots[proc->slot].publishing[owns_registration ? 0 : 1];
+  }
+
+  void published(uint32_t handle, int topic_hint) {
+    int topic = topic_hint >= 0 ? topic_hint : proc->topic_for(handle);
+    if (topic < 0) {
+      // Unknown topic: the counts per topic cannot be trusted until the next audit.
+      make_uncertain(-1);
+      return;
+    }
+    sh->published[topic]++;
+    sh->slots[proc->slot].published[topic]++;
   }
 
   void do_publish() {
-    Endpoint e = some_endpoint(pubs);
+    Ep e = some_endpoint(pubs);
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
     agnocast_publish arg{};
     arg.topic_handle = e.handle;
     arg.publisher_id = e.id;
-    arg.addr = reg->addr + (chance(90) ? rnd(reg->size ? reg->size : 1) : rng());
+    // Never slot-aligned: those carry well-formed messages only.
+    arg.addr =
+        (proc->reg.addr + (chance(90) ? rnd(proc->reg.size ? proc->reg.size : 1) : rng())) | 1;
     arg.bytes = rng();
     arg.wake_ids = some_ptr(4096);
     arg.wake_capacity = chance(80) ? 1024 : some_u32(4);
     arg.reclaim = some_ptr(4096);
     arg.reclaim_capacity = static_cast<uint32_t>(rnd(512));
     arg.reserved = chance(3) ? 1 : 0;
-    ioctl(dev, AGNOCAST_IOC_PUBLISH, &arg);
-  }
-
-  void close_pools(const agnocast_pool* pools, uint32_t n) {
-    for (uint32_t i = 0; i < n; i++) {
-      if (chance(20)) {
-        void* m = mmap(reinterpret_cast<void*>(pools[i].addr), 4096, PROT_READ,
-                       MAP_SHARED | MAP_FIXED_NOREPLACE, pools[i].fd, 0);
-        if (m != MAP_FAILED) munmap(m, 4096);
-      }
-      close(pools[i].fd);
-    }
+    publishing() = kNumTopics + 1;
+    int ret = call(AGNOCAST_IOC_PUBLISH, &arg, e.handle, arg.addr);
+    if (ret == 0) published(e.handle, -1);
+    publishing() = 0;
+    if (ret) return;
+    uint64_t addrs[AGNOCAST_RECLAIM_BATCH];
+    uint32_t n = std::min<uint32_t>(arg.reclaim_count, AGNOCAST_RECLAIM_BATCH);
+    std::memcpy(addrs, reinterpret_cast<const void*>(arg.reclaim), n * sizeof(uint64_t));
+    proc->reclaimed(addrs, n);
   }
 
   void do_receive() {
-    Endpoint e = some_endpoint(subs);
+    Ep e = some_endpoint(subs);
     agnocast_entry ents[16];
     agnocast_pool pools[4];
     agnocast_receive arg{};
@@ -172,36 +586,143 @@ struct Worker {
     for (uint32_t i = 0; i < arg.release_count; i++)
       release_ids[i] = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
     arg.release_ids = chance(95) ? uptr(release_ids) : uptr(bad_pointer());
-    if (ioc(dev, AGNOCAST_IOC_RECEIVE, &arg)) return;
-    for (uint32_t i = 0; i < arg.entry_count; i++) entries.push_back(ents[i].entry_id);
-    close_pools(pools, arg.pool_count);
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    if (call(AGNOCAST_IOC_RECEIVE, &arg, e.handle, e.id)) return;
+    if (arg.release_count) count(kReceiveReleases, 0);
+    if (arg.entry_count) count(kReceiveEntries, 0);
+    map_pools(pools, arg.pool_count, false);
+    int topic = proc->topic_for(e.handle);
+    for (uint32_t i = 0; i < arg.entry_count; i++) {
+      entries.push_back(ents[i].entry_id);
+      verify(topic, e.handle, e.id, ents[i], false);
+    }
   }
 
-  void do_take() {
-    Endpoint e = some_endpoint(subs);
+  void do_take(Ep e, bool wellformed) {
     agnocast_take arg{};
     arg.topic_handle = e.handle;
     arg.subscriber_id = e.id;
-    if (ioc(dev, AGNOCAST_IOC_TAKE, &arg)) return;
-    if (arg.entry_count) entries.push_back(arg.entry.entry_id);
-    close_pools(&arg.pool, arg.pool_count);
+    if (!wellformed && chance(3)) arg.flags = 1;
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    if (call(AGNOCAST_IOC_TAKE, &arg, e.handle, e.id)) return;
+    map_pools(&arg.pool, arg.pool_count, wellformed);
+    if (!arg.entry_count) return;
+    count(kTakeEntry, 0);
+    int topic = proc->topic_for(e.handle);
+    if (topic < 0)
+      sh->taken_overflow = true;
+    else
+      mark_taken(topic, e.id);
+    verify(topic, e.handle, e.id, arg.entry, false);
+    if (wellformed)
+      held.push_back({e.handle, e.id, topic, arg.entry.entry_id, arg.entry.addr});
+    else
+      entries.push_back(arg.entry.entry_id);
   }
 
   void do_release() {
-    Endpoint e = some_endpoint(subs);
+    Ep e = some_endpoint(subs);
     uint64_t ids[3];
     uint32_t count = 1 + static_cast<uint32_t>(rnd(3));
     for (uint32_t i = 0; i < count; i++)
       ids[i] = entries.empty() || chance(20) ? rnd(64) : entries[rnd(entries.size())];
     agnocast_release arg{e.handle, e.id, chance(95) ? uptr(ids) : uptr(bad_pointer()), count, 0};
-    ioctl(dev, AGNOCAST_IOC_RELEASE, &arg);
+    call(AGNOCAST_IOC_RELEASE, &arg, e.handle, ids[0]);
+  }
+
+  void do_reclaim(bool wellformed) {
+    uint64_t addrs[AGNOCAST_RECLAIM_BATCH];
+    agnocast_reclaim rc{wellformed ? uptr(addrs) : some_ptr(4096),
+                        wellformed ? AGNOCAST_RECLAIM_BATCH : static_cast<uint32_t>(rnd(600)), 0, 0,
+                        0};
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    if (call(AGNOCAST_IOC_RECLAIM, &rc, rc.reclaim_capacity) || !rc.reclaim_count) return;
+    count(kReclaimAddrs, 0);
+    uint32_t n = std::min<uint32_t>(rc.reclaim_count, AGNOCAST_RECLAIM_BATCH);
+    std::memcpy(addrs, reinterpret_cast<const void*>(rc.reclaim), n * sizeof(uint64_t));
+    proc->reclaimed(addrs, n);
+  }
+
+  void do_shed() {
+    agnocast_shed arg{};
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    if (call(AGNOCAST_IOC_SHED, chance(95) ? static_cast<void*>(&arg) : bad_pointer()) == 0 &&
+        arg.shed)
+      count(kShedEntries, 0);
+  }
+
+  void do_policy() {
+    switch (rnd(6)) {
+      case 0: {
+        agnocast_policy none{};
+        call(AGNOCAST_IOC_SET_POLICY, &none);
+        break;
+      }
+      case 1:
+      case 2: {
+        // Everyone may use every topic, through one rule or another.
+        std::vector<agnocast_policy_rule> rules(1 + rnd(3));
+        for (auto& r : rules) {
+          std::memset(&r, 0, sizeof(r));
+          const char* prefix = rnd(2) ? "" : kTopics[rnd(kNumTopics)];
+          std::strcpy(r.prefix, prefix);
+          r.match = *prefix ? static_cast<uint32_t>(rnd(3)) : AGNOCAST_MATCH_DESCENDANTS;
+          r.flags = AGNOCAST_RULE_PUBLISH | AGNOCAST_RULE_SUBSCRIBE;
+          r.first_principal = 0;
+          r.publish_count = r.subscribe_count = 1;
+        }
+        agnocast_principal principals[2] = {anyone_principal(), anyone_principal()};
+        agnocast_policy p{
+            AGNOCAST_POLICY_PRESENT, static_cast<uint32_t>(rules.size()), 2, 0, uptr(rules.data()),
+            uptr(principals)};
+        call(AGNOCAST_IOC_SET_POLICY, &p);
+        break;
+      }
+      case 3: {
+        // Briefly, one topic refuses root's publishers.
+        int ret = set_policy(
+            dev(),
+            {{kTopics[rnd(kNumTopics)], AGNOCAST_MATCH_EXACT,
+              std::vector<agnocast_principal>{group_principal(kAgnocastGroup)}, std::nullopt}});
+        count(kSetPolicy, -ret);
+        sh->ops++;
+        break;
+      }
+      case 4: {
+        agnocast_policy_rule rules[4];
+        agnocast_principal principals[8];
+        agnocast_policy p{0,
+                          static_cast<uint32_t>(rnd(5)),
+                          static_cast<uint32_t>(rnd(9)),
+                          0,
+                          uptr(rules),
+                          uptr(principals)};
+        call(AGNOCAST_IOC_GET_POLICY, &p);
+        break;
+      }
+      default: {
+        // Garbage policies.
+        for (int i = 0; i < 4096; i += 8) *reinterpret_cast<uint64_t*>(arena.base + i) = rng();
+        agnocast_policy p{static_cast<uint32_t>(rnd(4)),
+                          static_cast<uint32_t>(rnd(4)),
+                          static_cast<uint32_t>(rnd(4)),
+                          0,
+                          some_ptr(1024),
+                          some_ptr(64)};
+        call(AGNOCAST_IOC_SET_POLICY, &p);
+      }
+    }
   }
 
   void introspect() {
-    switch (rnd(4)) {
+    switch (rnd(6)) {
       case 0: {
         agnocast_list_topics arg{some_ptr(4096), some_u32(16), 0, 0, 0};
-        ioctl(dev, AGNOCAST_IOC_LIST_TOPICS, &arg);
+        call(AGNOCAST_IOC_LIST_TOPICS, &arg);
         break;
       }
       case 1: {
@@ -211,12 +732,25 @@ struct Worker {
         info.subscribers = some_ptr(4096);
         info.publisher_capacity = some_u32(20);
         info.subscriber_capacity = some_u32(20);
-        ioctl(dev, AGNOCAST_IOC_TOPIC_INFO, &info);
+        call(AGNOCAST_IOC_TOPIC_INFO, &info);
         break;
       }
       case 2: {
         agnocast_list_processes arg{some_ptr(4096), some_u32(100), 0, 0, 0};
-        ioctl(dev, AGNOCAST_IOC_LIST_PROCESSES, &arg);
+        call(AGNOCAST_IOC_LIST_PROCESSES, &arg);
+        break;
+      }
+      case 3: {
+        agnocast_topic_schema s{};
+        std::strcpy(s.name, kTopics[rnd(std::size(kTopics))]);
+        s.schema = some_ptr(4096);
+        s.capacity = some_u32(64);
+        call(AGNOCAST_IOC_TOPIC_SCHEMA, &s);
+        break;
+      }
+      case 4: {
+        agnocast_version v{};
+        call(AGNOCAST_IOC_GET_VERSION, chance(90) ? static_cast<void*>(&v) : bad_pointer());
         break;
       }
       default: {
@@ -232,63 +766,331 @@ struct Worker {
     }
   }
 
+  // --- Well-formed steps ------------------------------------------------
+
+  void wf_publish() {
+    if (pubs.empty()) return add_endpoint(true, true);
+    Ep& e = pubs[rnd(pubs.size())];
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    uint64_t addr;
+    {
+      std::lock_guard<std::mutex> g(proc->mu);
+      if (proc->free_slots.empty() || !proc->reg.map) return;
+      size_t i = rnd(std::min<size_t>(proc->free_slots.size(), 4));
+      addr = proc->free_slots[proc->free_slots.size() - 1 - i];
+      proc->free_slots.erase(proc->free_slots.end() - 1 - static_cast<ptrdiff_t>(i));
+    }
+    const int topic = proc->topic_for(e.handle);
+    if (topic < 0) {
+      proc->reclaimed(&addr, 1);
+      return;
+    }
+    Message m{kMagic, static_cast<uint32_t>(topic), e.id, getpid(), 0, ++e.seq, addr, 0};
+    m.sum = checksum(m);
+    std::memcpy(reinterpret_cast<void*>(addr), &m, sizeof(m));
+    static thread_local uint32_t wake[AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX];
+    uint64_t reclaim[AGNOCAST_RECLAIM_BATCH];
+    agnocast_publish arg{};
+    arg.topic_handle = e.handle;
+    arg.publisher_id = e.id;
+    arg.addr = addr;
+    arg.bytes = sizeof(m);
+    arg.wake_ids = uptr(wake);
+    arg.wake_capacity = AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX;
+    arg.reclaim = uptr(reclaim);
+    arg.reclaim_capacity = AGNOCAST_RECLAIM_BATCH;
+    publishing() = topic + 1;
+    int ret = call(AGNOCAST_IOC_PUBLISH, &arg, e.handle, addr);
+    if (ret == 0) published(e.handle, topic);
+    publishing() = 0;
+    if (ret) {
+      proc->reclaimed(&addr, 1);
+      return;
+    }
+    if (arg.reclaim_count) count(kPublishReclaim, 0);
+    proc->reclaimed(reclaim, arg.reclaim_count);
+  }
+
+  void wf_receive() {
+    if (subs.empty()) return add_endpoint(false, true);
+    Ep e = subs[rnd(subs.size())];
+    if (e.flags & AGNOCAST_POLLING) return wf_take(e);
+    uint64_t rel[8];
+    std::vector<Held> released;
+    const size_t max_release = chance(20) ? 0 : 8;
+    for (const Held& h : held)
+      if (h.handle == e.handle && h.sub_id == e.id && released.size() < max_release)
+        released.push_back(h);
+    // Read the held messages once more before they go back.
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    std::vector<bool> wrong(released.size());
+    for (size_t i = 0; i < released.size(); i++) {
+      rel[i] = released[i].entry_id;
+      wrong[i] = !held_ok(released[i]);
+    }
+    agnocast_entry ents[8];
+    agnocast_pool pools[AGNOCAST_RECEIVE_POOLS_MAX];
+    agnocast_receive arg{};
+    arg.topic_handle = e.handle;
+    arg.subscriber_id = e.id;
+    arg.entries = uptr(ents);
+    arg.pools = uptr(pools);
+    arg.entry_capacity = 1 + static_cast<uint32_t>(rnd(8));
+    arg.pool_capacity = AGNOCAST_RECEIVE_POOLS_MAX;
+    arg.release_count = static_cast<uint32_t>(released.size());
+    arg.release_ids = uptr(rel);
+    int ret = call(AGNOCAST_IOC_RECEIVE, &arg, e.handle, arg.release_count);
+    if (ret == 0 || ret == ENOENT || ret == ESRCH || ret == EXDEV) {
+      // Released now, or not held any more (removed by another thread).
+      std::erase_if(held, [&](const Held& h) {
+        for (const Held& r : released)
+          if (r.handle == h.handle && r.sub_id == h.sub_id && r.entry_id == h.entry_id) return true;
+        return false;
+      });
+    }
+    if (ret) return;
+    for (size_t i = 0; i < released.size(); i++)
+      if (wrong[i]) fail("a held message changed before its release", rel[i], released[i].addr);
+    if (arg.release_count) count(kReceiveReleases, 0);
+    if (arg.entry_count) count(kReceiveEntries, 0);
+    map_pools(pools, arg.pool_count, true);
+    const int topic = proc->topic_for(e.handle);
+    for (uint32_t i = 0; i < arg.entry_count; i++) {
+      held.push_back({e.handle, e.id, topic, ents[i].entry_id, ents[i].addr});
+      // Checked once the pools are mapped; kept for the check at release.
+      verify(topic, e.handle, e.id, ents[i], false);
+    }
+  }
+
+  // The message of a held entry is (still) one of its topic.
+  bool held_ok(const Held& h) {
+    std::lock_guard<std::mutex> g(proc->mu);
+    auto it = proc->views.upper_bound(h.addr);
+    if (it == proc->views.begin()) return true;
+    --it;
+    if (h.addr + sizeof(Message) > it->first + it->second || (h.addr - it->first) % kSlotBytes)
+      return true;
+    Message m;
+    std::memcpy(&m, reinterpret_cast<const void*>(h.addr), sizeof(m));
+    sh->rechecked++;
+    return m.magic == kMagic && m.sum == checksum(m) && m.addr == h.addr &&
+           static_cast<int>(m.topic) == h.topic;
+  }
+
+  void wf_take(Ep e) { do_take(e, true); }
+
+  void wf_release() {
+    if (held.empty()) return;
+    const Held first = held[rnd(held.size())];
+    std::vector<Held> released;
+    for (const Held& h : held)
+      if (h.handle == first.handle && h.sub_id == first.sub_id && released.size() < 4)
+        released.push_back(h);
+    std::vector<uint64_t> ids;
+    std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    bool wrong = false;
+    for (const Held& h : released) {
+      ids.push_back(h.entry_id);
+      wrong |= !held_ok(h);
+    }
+    agnocast_release arg{first.handle, first.sub_id, uptr(ids.data()),
+                         static_cast<uint32_t>(ids.size()), 0};
+    int ret = call(AGNOCAST_IOC_RELEASE, &arg, first.handle, ids[0]);
+    if (ret == 0 && wrong) fail("a held message changed before its release", ids[0], first.addr);
+    std::erase_if(held, [&](const Held& h) {
+      for (const Held& r : released)
+        if (r.handle == h.handle && r.sub_id == h.sub_id && r.entry_id == h.entry_id) return true;
+      return false;
+    });
+  }
+
+  // The device file goes away under the other thread: its descriptor
+  // number now names a new open file of the device.  Registration belongs to
+  // the process, not the file, so nothing else changes.
+  void swap_device() {
+    int fd = open_device();
+    if (fd < 0) return;  // a worker outside group agnocast cannot reopen it
+    dup2(fd, proc->dev);
+    close(fd);
+    sh->device_swaps++;
+  }
+
+  // A child forked with the device open is a process of its own: not
+  // registered, owner of none of its parent's endpoints or entries.
+  void fork_child() {
+    Ep pub = pubs.empty() ? Ep{} : pubs[0];
+    Ep sub = subs.empty() ? Ep{} : subs[0];
+    uint64_t held_id = held.empty() ? 0 : held[0].entry_id;
+    bool has_held = !held.empty();
+    int dev = proc->dev;
+    uint64_t seed = proc->seed;
+    sh->forks++;
+    pid_t pid = fork();
+    if (pid == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      auto expect = [&](int row, unsigned long cmd, void* arg, const char* what) {
+        int ret = counted_ioctl(row, dev, cmd, arg);
+        if (ret != ESRCH && !(ret == EACCES && row == kAddSubscriber)) report(what, ret, seed);
+      };
+      agnocast_add_endpoint ep = endpoint(kTopics[0], 1);
+      expect(kAddSubscriber, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep,
+             "a fork child, not registered, added a subscriber");
+      if (!pubs.empty()) {
+        agnocast_publish arg{};
+        arg.topic_handle = pub.handle;
+        arg.publisher_id = pub.id;
+        arg.addr = proc->reg.addr;
+        arg.wake_ids = uptr(arena.base);
+        arg.wake_capacity = 1;
+        expect(kPublish, AGNOCAST_IOC_PUBLISH, &arg,
+               "a fork child published on its parent's publisher");
+      }
+      if (has_held) {
+        agnocast_release rel{sub.handle, sub.id, uptr(&held_id), 1, 0};
+        expect(kRelease, AGNOCAST_IOC_RELEASE, &rel, "a fork child released its parent's entry");
+      }
+      // Registering and leaving without a word: the kernel cleans up.
+      agnocast_register_process reg{};
+      reg.pool_fd = -1;
+      if (counted_ioctl(kRegister, dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg) == 0) {
+        agnocast_add_endpoint ep2 = endpoint(kTopics[rnd(kNumTopics)], 1 + rnd(4));
+        counted_ioctl(kAddPublisher, dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep2);
+      }
+      _exit(0);
+    }
+    if (pid > 0) waitpid(pid, nullptr, 0);
+  }
+
+  // The worker execs a new worker image in place (same pid): the kernel
+  // drops what the old image held.  Outside group agnocast it could not
+  // reopen the device, so it does not.
+  void exec_self() {
+    if (proc->seed % 8 == 6) return;
+    char slot[16], seed[32], fd[16];
+    std::snprintf(slot, sizeof(slot), "%d", proc->slot);
+    std::snprintf(seed, sizeof(seed), "%llu",
+                  static_cast<unsigned long long>(proc->seed * 0x9E3779B97F4A7C15ull + 7));
+    std::snprintf(fd, sizeof(fd), "%d", shared_fd);
+    sh->execs++;
+    execl("/proc/self/exe", "agnocast_fuzz_test", "--worker", slot, seed, fd,
+          static_cast<char*>(nullptr));
+    sh->execs--;
+  }
+
+  void reregister() {
+    std::unique_lock<std::shared_mutex> lock(proc->pool_lock);
+    std::unique_lock<std::shared_mutex> eps(proc->ep_lock);
+    std::lock_guard<std::mutex> g(proc->mu);
+    count(kUnregister, -ioc0(proc->dev, AGNOCAST_IOC_UNREGISTER_PROCESS));
+    sh->ops++;
+    if (proc->reg.map) munmap(proc->reg.map, proc->reg.size);
+    if (proc->reg.memfd >= 0) close(proc->reg.memfd);
+    for (auto& [addr, size] : proc->views)
+      if (addr != proc->reg.addr) munmap(reinterpret_cast<void*>(addr), size);
+    proc->reg = Registration{};
+    proc->topic_of.clear();
+    pubs.clear();
+    subs.clear();
+    held.clear();
+    entries.clear();
+    if (chance(90)) register_process(proc, true);
+    proc->reset_pool();
+  }
+
+  static void register_process(Process* p, bool attach) {
+    int ret = p->reg.reserve(p->dev);
+    count(kRegister, -ret);
+    sh->ops++;
+    if (ret || !attach) return;
+    ret = p->reg.attach();
+    count(kRegister, -ret);
+    sh->ops++;
+  }
+
   void step() {
-    switch (rnd(20)) {
+    if (chance(40)) {
+      // Well-formed: the paths that reach deep.
+      switch (rnd(16)) {
+        case 0:
+          return add_endpoint(true, true);
+        case 1:
+        case 2:
+          return add_endpoint(false, true);
+        case 3:
+        case 4:
+        case 5:
+        case 6:
+          return wf_publish();
+        case 7:
+        case 8:
+        case 9:
+        case 10:
+          return wf_receive();
+        case 11:
+          return wf_release();
+        case 12:
+          return do_reclaim(true);
+        case 13:
+          return do_shed();
+        default:
+          if (!subs.empty() && chance(50)) return do_take(subs[rnd(subs.size())], true);
+          return wf_publish();
+      }
+    }
+    switch (rnd(21)) {
       case 0:
-        garbage();
-        break;
       case 1:
-        garbage();
-        break;
+        return garbage();
       case 2:
         // Only the main thread re-registers; the other one may briefly use
         // a stale pool address, which the kernel must refuse cleanly.
-        if (owns_registration && chance(1)) {
-          reg->drop();
-          pubs.clear();
-          subs.clear();
-          entries.clear();
-          if (chance(90)) reg->full(dev);
-        }
-        break;
+        if (owns_registration && chance(10)) return reregister();
+        if (chance(2)) return swap_device();
+        if (owns_registration && chance(2)) return fork_child();
+        if (owns_registration && chance(1)) return exec_self();
+        return;
       case 3:
-        add_endpoint(true);
-        break;
+        return add_endpoint(true, false);
       case 4:
       case 5:
-        add_endpoint(false);
-        break;
+        return add_endpoint(false, false);
       case 6:
-        remove_endpoint(true);
-        break;
+        return remove_endpoint(true);
       case 7:
-        remove_endpoint(false);
-        break;
+        return remove_endpoint(false);
       case 8:
       case 9:
+        return do_publish();
       case 10:
       case 11:
-        do_publish();
-        break;
+        return do_receive();
       case 12:
+        return do_take(some_endpoint(subs), false);
       case 13:
-        do_receive();
-        break;
       case 14:
-        do_take();
-        break;
+        return do_release();
       case 15:
+        return do_reclaim(false);
       case 16:
-        do_release();
-        break;
-      case 17: {
-        agnocast_reclaim rc{some_ptr(4096), static_cast<uint32_t>(rnd(600)), 0, 0, 0};
-        ioctl(dev, AGNOCAST_IOC_RECLAIM, &rc);
-        break;
-      }
+        return do_shed();
+      case 17:
+        if (chance(30)) do_policy();
+        return;
       default:
-        introspect();
+        return introspect();
     }
+  }
+
+  // Pauses while the parent audits.
+  void maybe_pause() {
+    if (!sh->pause.load(std::memory_order_relaxed)) return;
+    auto& slot = sh->slots[proc->slot];
+    slot.paused++;
+    while (sh->pause.load()) usleep(500);
+    slot.paused--;
   }
 };
 
@@ -296,80 +1098,316 @@ std::atomic<bool> stop_threads{false};
 
 void* thread_main(void* p) {
   auto* w = static_cast<Worker*>(p);
-  while (!stop_threads.load(std::memory_order_relaxed)) w->step();
+  while (!stop_threads.load(std::memory_order_relaxed)) {
+    w->maybe_pause();
+    w->step();
+  }
   return nullptr;
 }
 
-// A worker process: registers (usually), then two threads fuzz until killed.
-[[noreturn]] void worker_process(uint64_t seed) {
-  int dev = open_device();
-  Registration reg;
-  std::mt19937_64 rng(seed);
-  if (rng() % 10) {
-    reg.reserve(dev);
-    if (rng() % 10) reg.attach();
+// Mostly root; some are nobody in group agnocast, who may open the device;
+// some are nobody outside it, who may not, but use a descriptor root opened
+// for them (a descriptor carries its opener's rights).
+void identity(Process* proc, uint64_t seed) {
+  if ((proc->dev = open_device()) < 0) {
+    report("root could not open the device", errno, seed);
+  } else if (seed % 8 == 5) {
+    close(proc->dev);
+    if (!become(kNobody, kNobody, {kAgnocastGroup})) report("could not become nobody", errno, seed);
+    proc->dev = open_device();
+    if (proc->dev < 0) report("a member of group agnocast could not open the device", errno, seed);
+    sh->members++;
+  } else if (seed % 8 == 6) {
+    if (!become(kNobody, kNobody, {})) report("could not become nobody", errno, seed);
+    int fd = open_device();
+    if (fd >= 0 || errno != EACCES)
+      report("a process outside group agnocast opened the device", fd >= 0 ? 0 : errno, seed);
+    if (fd >= 0) close(fd);
+    sh->non_members++;
   }
-  Worker a{std::mt19937_64(seed * 3 + 1), dev, &reg, true, {}, {}, {}, {}};
-  Worker b{std::mt19937_64(seed * 5 + 2), dev, &reg, false, {}, {}, {}, {}};
+}
+
+// A worker process: registers (usually), then two threads fuzz until killed.
+[[noreturn]] void worker_process(int slot, uint64_t seed, bool execed) {
+  sh->slots[slot].pid = getpid();
+  auto* proc = new Process;
+  proc->slot = slot;
+  proc->seed = seed;
+  if (execed) {
+    // The old image's other thread died anywhere, maybe mid-publish; its
+    // pause is void.  Its registration must go, soon.
+    settle_slot(slot);
+    make_uncertain(-1);
+    sh->slots[slot].paused = 0;
+    proc->dev = open_device();
+    if (!eventually([&] { return !process_listed(proc->dev, getpid()); }))
+      report("a process that exec'd is still registered", 0, seed);
+  } else {
+    identity(proc, seed);
+  }
+  std::mt19937_64 rng(seed);
+  if (rng() % 10) Worker::register_process(proc, rng() % 10 != 0);
+  proc->reset_pool();
+  auto* a = new Worker(seed * 3 + 1, proc, true);
+  auto* b = new Worker(seed * 5 + 2, proc, false);
   pthread_t t;
-  pthread_create(&t, nullptr, thread_main, &b);
+  pthread_create(&t, nullptr, thread_main, b);
   for (uint64_t i = 0;; i++) {
-    a.step();
+    a->maybe_pause();
+    a->step();
     // Some workers end on their own, with or without unregistering.
-    if (i == 20000 && seed % 3 == 0) _exit(0);
+    if (i == 5000 && seed % 3 == 0) {
+      if (seed % 2) counted_ioctl(kUnregister, proc->dev, AGNOCAST_IOC_UNREGISTER_PROCESS, nullptr);
+      _exit(0);
+    }
+  }
+}
+
+// --- The parent's audit of the kernel's counters ---------------------------
+
+struct SubSnapshot {
+  int pid;
+  uint32_t flags;
+  uint64_t total;  // received + unreceived + dropped
+  uint64_t published;
+  uint64_t uncertain;
+  uint64_t own;  // published by the owner's worker slot, or ~0
+};
+std::map<std::pair<int, uint32_t>, SubSnapshot> last_audit;
+uint64_t audits = 0, audit_checks = 0, audits_skipped = 0;
+
+bool audit(int dev, const std::vector<pid_t>& workers) {
+  sh->pause = true;
+  bool all = eventually(
+      [&] {
+        for (size_t i = 0; i < workers.size(); i++) {
+          siginfo_t info{};
+          if (waitid(P_PID, static_cast<id_t>(workers[i]), &info, WEXITED | WNOHANG | WNOWAIT) ||
+              info.si_pid) {
+            settle_slot(static_cast<int>(i));  // dead
+            continue;
+          }
+          if (sh->slots[i].paused.load() < 2) return false;
+        }
+        return true;
+      },
+      3000);
+  if (!all) {
+    sh->pause = false;
+    audits_skipped++;
+    return true;
+  }
+  // Everyone is between steps: the counts are settled.
+  bool ok = true;
+  std::map<std::pair<int, uint32_t>, SubSnapshot> now;
+  std::vector<agnocast_subscriber_info> subs(2048);
+  for (int t = 0; t < kNumTopics; t++) {
+    agnocast_topic_info info{};
+    std::strcpy(info.name, kTopics[t]);
+    info.subscribers = uptr(subs.data());
+    info.subscriber_capacity = static_cast<uint32_t>(subs.size());
+    if (ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info)) continue;
+    uint64_t published = sh->published[t], uncertain = sh->uncertain[t];
+    for (uint32_t i = 0; i < std::min<uint32_t>(info.subscriber_total, 2048); i++) {
+      const auto& s = subs[i];
+      uint64_t own = ~0ull;
+      for (size_t w = 0; w < workers.size(); w++)
+        if (sh->slots[w].pid == s.pid) own = sh->slots[w].published[t];
+      SubSnapshot snap{s.pid,     s.flags,   s.received + s.unreceived + s.dropped,
+                       published, uncertain, own};
+      auto prev = last_audit.find({t, s.id});
+      now[{t, s.id}] = snap;
+      if (prev == last_audit.end() || prev->second.pid != s.pid ||
+          prev->second.uncertain != uncertain)
+        continue;
+      uint64_t expect = published - prev->second.published;
+      if (s.flags & AGNOCAST_IGNORE_LOCAL) {
+        if (own == ~0ull || prev->second.own == ~0ull) continue;
+        expect -= own - prev->second.own;
+      }
+      // Signed: TAKE passes older unreceived entries over uncounted.
+      auto got = static_cast<int64_t>(snap.total - prev->second.total);
+      bool took = sh->taken_overflow || was_taken(t, s.id);
+      audit_checks++;
+      if (took ? got > static_cast<int64_t>(expect) : got != static_cast<int64_t>(expect)) {
+        std::printf(
+            "fuzz: FAIL: %s subscriber %u (pid %d, flags %u): received + unreceived + dropped "
+            "grew by %lld, %llu published meanwhile%s\n",
+            kTopics[t], s.id, s.pid, s.flags, static_cast<long long>(got),
+            static_cast<unsigned long long>(expect), took ? " (it took)" : "");
+        ok = false;
+      }
+    }
+  }
+  // Only a TAKE between two audits passes entries over: the table of
+  // subscribers that took starts afresh, and does not fill up in a long run.
+  for (auto& k : sh->taken) k = 0;
+  sh->taken_overflow = false;
+  last_audit = std::move(now);
+  audits++;
+  sh->pause = false;
+  return ok;
+}
+
+void print_table() {
+  std::printf("fuzz: %-20s %10s  errors\n", "command", "ok");
+  for (int r = 0; r < kRows; r++) {
+    std::printf("fuzz: %-20s %10llu ", kRowNames[r],
+                static_cast<unsigned long long>(sh->count[r][0].load()));
+    for (int e = 1; e < kErrnos; e++) {
+      uint64_t n = sh->count[r][e];
+      if (!n) continue;
+      const char* name = strerrorname_np(e);
+      if (name)
+        std::printf(" %s:%llu", name, static_cast<unsigned long long>(n));
+      else
+        std::printf(" %d:%llu", e, static_cast<unsigned long long>(n));
+    }
+    std::printf("\n");
   }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int seconds = argc > 1 ? std::atoi(argv[1]) : 30;
-  const int nprocs = argc > 2 ? std::atoi(argv[2]) : 6;
-  std::mt19937_64 rng(static_cast<uint64_t>(getpid()) * 7919 + time(nullptr));
-  const uint64_t base_seed = rng();
-  std::printf("fuzz: %d s, %d processes, seed %llu\n", seconds, nprocs,
-              static_cast<unsigned long long>(base_seed));
+  // A worker that exec'd: agnocast_fuzz_test --worker SLOT SEED SHARED_FD.
+  if (argc == 5 && std::string(argv[1]) == "--worker") {
+    shared_fd = std::atoi(argv[4]);
+    sh = static_cast<Shared*>(
+        mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
+    if (sh == MAP_FAILED) return 2;
+    worker_process(std::atoi(argv[2]), std::strtoull(argv[3], nullptr, 10), true);
+  }
+  int seconds = -1, nprocs = 6;
+  long long min_ops = -1;
+  bool long_mode = std::getenv("AGNOCAST_FUZZ_LONG") != nullptr;
+  uint64_t base_seed = 0;
+  bool seeded = false;
+  int positional = 0;
+  for (int i = 1; i < argc; i++) {
+    std::string a = argv[i];
+    if (a == "--long") {
+      long_mode = true;
+    } else if (a == "--ops" && i + 1 < argc) {
+      min_ops = std::atoll(argv[++i]);
+    } else if (a == "--seed" && i + 1 < argc) {
+      base_seed = std::strtoull(argv[++i], nullptr, 0);
+      seeded = true;
+    } else if (positional == 0) {
+      seconds = std::atoi(argv[i]), positional++;
+    } else {
+      nprocs = std::atoi(argv[i]), positional++;
+    }
+  }
+  if (seconds < 0) seconds = long_mode ? 4 * 3600 : 30;
+  if (min_ops < 0) min_ops = long_mode ? 1000000 : 0;
+  nprocs = std::clamp(nprocs, 1, kMaxProcs);
+  if (!seeded) base_seed = std::random_device{}() ^ (static_cast<uint64_t>(time(nullptr)) << 20);
+  std::printf("fuzz: %d s and %lld operations at least, %d processes, seed %llu\n", seconds,
+              min_ops, nprocs, static_cast<unsigned long long>(base_seed));
   std::fflush(stdout);
 
+  shared_fd = memfd_create("agnocast-fuzz", 0);
+  if (shared_fd < 0 || ftruncate(shared_fd, sizeof(Shared))) return 2;
+  sh = static_cast<Shared*>(
+      mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
+  std::mt19937_64 rng(base_seed);
   std::vector<pid_t> workers(nprocs);
   uint64_t spawned = 0;
   auto spawn = [&](int i) {
     uint64_t seed = base_seed + spawned++;
+    sh->slots[i].paused = 0;
+    for (auto& p : sh->slots[i].published) p = 0;
+    sh->slots[i].pid = 0;
     pid_t pid = fork();
-    if (pid == 0) worker_process(seed);
+    if (pid == 0) worker_process(i, seed, false);
+    sh->slots[i].pid = pid;
     workers[i] = pid;
   };
   for (int i = 0; i < nprocs; i++) spawn(i);
 
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
-  while (std::chrono::steady_clock::now() < deadline) {
+  int dev = open_device();
+  bool ok = true;
+  const auto start = std::chrono::steady_clock::now();
+  const auto deadline = start + std::chrono::seconds(seconds);
+  auto next_audit = start + std::chrono::seconds(1);
+  auto next_report = start + std::chrono::seconds(600);
+  while (std::chrono::steady_clock::now() < deadline ||
+         sh->ops.load() < static_cast<uint64_t>(min_ops)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50 + rng() % 200));
+    auto now = std::chrono::steady_clock::now();
+    if (now >= next_audit) {
+      ok &= audit(dev, workers);
+      next_audit = now + std::chrono::milliseconds(500 + rng() % 1000);
+    }
+    if (now >= next_report) {
+      std::printf("fuzz: %llu operations after %lld s\n",
+                  static_cast<unsigned long long>(sh->ops.load()),
+                  static_cast<long long>(
+                      std::chrono::duration_cast<std::chrono::seconds>(now - start).count()));
+      std::fflush(stdout);
+      next_report = now + std::chrono::seconds(600);
+    }
+    if (rng() % 3) continue;
     int i = static_cast<int>(rng() % nprocs);
     int status;
     if (waitpid(workers[i], &status, WNOHANG) == 0) {
       kill(workers[i], SIGKILL);
       waitpid(workers[i], &status, 0);
     }
+    settle_slot(i);
     spawn(i);
   }
   for (pid_t pid : workers) {
     kill(pid, SIGKILL);
     waitpid(pid, nullptr, 0);
   }
+  auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(
+      std::chrono::steady_clock::now() - start);
 
   // Every worker is gone: so must be every registration and every topic.
-  int dev = open_device();
   bool clean = eventually([&] {
     agnocast_list_topics lt{0, 0, 0, 0, 0};
     return list_processes(dev).empty() && ioc(dev, AGNOCAST_IOC_LIST_TOPICS, &lt) == 0 &&
            lt.total == 0;
   });
   size_t records = drain_exit_records(dev).size();
-  std::printf("fuzz: %llu worker processes, %zu exit records, state %s\n",
-              static_cast<unsigned long long>(spawned), records, clean ? "clean" : "LEFT OVER");
-  if (!clean) {
-    for (const auto& p : list_processes(dev)) std::printf("  left: pid %d\n", p.pid);
-    return 1;
+  print_table();
+  std::printf(
+      "fuzz: %llu operations in %.1f s, %llu worker processes, %zu exit records\n"
+      "fuzz: messages checked: %llu on receipt, %llu again at release, %llu unreadable\n"
+      "fuzz: %llu audits (%llu subscriber counts checked, %llu audits skipped)\n"
+      "fuzz: %llu forks with the device open, %llu device files replaced in use, %llu workers "
+      "as a member of group agnocast, %llu as a non-member, %llu execs\n",
+      static_cast<unsigned long long>(sh->ops.load()), static_cast<double>(elapsed.count()) / 1000,
+      static_cast<unsigned long long>(spawned), records,
+      static_cast<unsigned long long>(sh->verified.load()),
+      static_cast<unsigned long long>(sh->rechecked.load()),
+      static_cast<unsigned long long>(sh->unverifiable.load()),
+      static_cast<unsigned long long>(audits), static_cast<unsigned long long>(audit_checks),
+      static_cast<unsigned long long>(audits_skipped),
+      static_cast<unsigned long long>(sh->forks.load()),
+      static_cast<unsigned long long>(sh->device_swaps.load()),
+      static_cast<unsigned long long>(sh->members.load()),
+      static_cast<unsigned long long>(sh->non_members.load()),
+      static_cast<unsigned long long>(sh->execs.load()));
+  for (int r = 0; r < kRows; r++) {
+    if (r == kUnknown || sh->count[r][0]) continue;
+    std::printf("fuzz: FAIL: %s never succeeded\n", kRowNames[r]);
+    ok = false;
   }
-  return 0;
+  if (sh->failures) {
+    std::printf("fuzz: FAIL: %llu wrong messages (see above)\n",
+                static_cast<unsigned long long>(sh->failures.load()));
+    ok = false;
+  }
+  if (!clean) {
+    std::printf("fuzz: FAIL: state left over after every worker exited\n");
+    for (const auto& p : list_processes(dev)) std::printf("  left: pid %d\n", p.pid);
+    ok = false;
+  }
+  std::printf("fuzz: %s (seed %llu; replay: agnocast_fuzz_test %d %d --ops %lld --seed %llu)\n",
+              ok ? "PASS" : "FAIL", static_cast<unsigned long long>(base_seed), seconds, nprocs,
+              min_ops, static_cast<unsigned long long>(base_seed));
+  return ok ? 0 : 1;
 }

@@ -2,30 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
-#include <charconv>
 #include <utility>
 
 #include "sweeper.hpp"
 
 namespace agnocastd {
-
-namespace {
-constexpr std::string_view pool_prefix = "agnocast@";
-}
-
-std::string pool_object_name(pid_t pid) { return std::string(pool_prefix) + std::to_string(pid); }
-
-std::optional<pid_t> parse_pool_object_name(const std::string& file) {
-  if (!file.starts_with(pool_prefix)) return std::nullopt;
-  const std::string_view digits = std::string_view(file).substr(pool_prefix.size());
-  if (digits.empty() || digits.front() == '0') return std::nullopt;
-  pid_t pid = 0;
-  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
-  if (error != std::errc{} || end != digits.data() + digits.size() || pid <= 0) {
-    return std::nullopt;
-  }
-  return pid;
-}
 
 std::vector<DeadProcess> DeadProcessCollector::add(
     const std::vector<agnocast::ExitRecord>& records) {
@@ -60,12 +41,6 @@ void clean_dead_process(const DeadProcess& process, Host& host, Counters& counte
       ++counters.queues_removed;
       spdlog::info("removed queue {} of dead process {}", queue, process.pid);
     }
-  }
-  // A recycled pid may already belong to a new process that owns this object.
-  const std::string pool = pool_object_name(process.pid);
-  if (!host.process_alive(process.pid) && host.remove_shm(pool)) {
-    ++counters.shm_removed;
-    spdlog::info("removed shared memory /dev/shm/{} of dead process {}", pool, process.pid);
   }
   ++counters.processes_cleaned;
   spdlog::info("cleaned up after dead process {} ({} queue(s))", process.pid,

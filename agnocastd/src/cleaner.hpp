@@ -6,7 +6,6 @@
 
 #include <cstdint>
 #include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,13 +14,6 @@
 #include "host.hpp"
 
 namespace agnocastd {
-
-// "agnocast@<pid>": the /dev/shm file name of a process's pool, kept for
-// pools that older tools created as named objects (the kernel now hands out
-// memfds, which vanish by themselves).
-std::string pool_object_name(pid_t pid);
-// The pid of a pool object file name, nullopt for any other name.
-std::optional<pid_t> parse_pool_object_name(const std::string& file);
 
 struct DeadProcess {
   pid_t pid = 0;
@@ -41,9 +33,9 @@ class DeadProcessCollector {
   std::uint64_t lost_ = 0;
 };
 
-// Removes what one dead process left, always in this order: its queues (no
-// publisher can wake a dead subscriber any more), then its pool object, then
-// it is counted.
+// Removes what one dead process left: its queues (no publisher can wake a
+// dead subscriber any more), then counts it.  Its pool is a memfd, which the
+// kernel frees itself.
 void clean_dead_process(const DeadProcess& process, Host& host, Counters& counters);
 
 // Cleans up after the processes these records complete; when the kernel

@@ -18,16 +18,6 @@ ExitRecord queue_record(pid_t pid, std::string topic, std::uint32_t id) {
 ExitRecord process_record(pid_t pid) { return {ExitRecord::Kind::process, pid, {}, 0}; }
 ExitRecord lost_record(std::uint32_t count) { return {ExitRecord::Kind::lost, 0, {}, 0, count}; }
 
-TEST(PoolObjectName, RoundTrips) {
-  EXPECT_EQ(pool_object_name(1234), "agnocast@1234");
-  EXPECT_EQ(parse_pool_object_name("agnocast@1234"), 1234);
-  EXPECT_EQ(parse_pool_object_name("agnocast@"), std::nullopt);
-  EXPECT_EQ(parse_pool_object_name("agnocast@012"), std::nullopt);
-  EXPECT_EQ(parse_pool_object_name("agnocast@12x"), std::nullopt);
-  EXPECT_EQ(parse_pool_object_name("agnocast@99999999999"), std::nullopt);
-  EXPECT_EQ(parse_pool_object_name("chatter@1"), std::nullopt);
-}
-
 TEST(DeadProcessCollector, GroupsQueuesWithTheirProcess) {
   DeadProcessCollector collector;
   const auto dead = collector.add({queue_record(10, "/a/b", 1), queue_record(11, "/c", 0),
@@ -42,28 +32,14 @@ TEST(DeadProcessCollector, GroupsQueuesWithTheirProcess) {
   EXPECT_THAT(later[1].queues, IsEmpty());
 }
 
-TEST(CleanDeadProcess, RemovesQueuesThenPoolThenCounts) {
+TEST(CleanDeadProcess, RemovesItsQueuesThenCounts) {
   FakeHost host;
   host.queues = {"chatter@1", "chatter@2"};
-  host.shm = {"agnocast@77"};
   Counters counters;
   clean_dead_process({77, {"/chatter@1", "/gone@5"}}, host, counters);
-  EXPECT_THAT(host.calls, ElementsAre("remove_queue /chatter@1", "remove_queue /gone@5",
-                                      "remove_shm agnocast@77"));
+  EXPECT_THAT(host.calls, ElementsAre("remove_queue /chatter@1", "remove_queue /gone@5"));
   EXPECT_EQ(host.queues, std::set<std::string>{"chatter@2"});
   EXPECT_EQ(counters.queues_removed, 1u);  // /gone@5 was not there
-  EXPECT_EQ(counters.shm_removed, 1u);
-  EXPECT_EQ(counters.processes_cleaned, 1u);
-}
-
-TEST(CleanDeadProcess, LeavesThePoolObjectOfARecycledPid) {
-  FakeHost host;
-  host.shm = {"agnocast@77"};
-  host.alive = {77};
-  Counters counters;
-  clean_dead_process({77, {}}, host, counters);
-  EXPECT_EQ(host.shm.size(), 1u);
-  EXPECT_EQ(counters.shm_removed, 0u);
   EXPECT_EQ(counters.processes_cleaned, 1u);
 }
 
@@ -74,28 +50,26 @@ TEST(HandleExitRecords, CleansCompletedProcessesWithoutSweeping) {
   Counters counters;
   EXPECT_FALSE(handle_exit_records({queue_record(10, "/a", 1)}, collector, host, counters));
   EXPECT_TRUE(handle_exit_records({process_record(10)}, collector, host, counters));
-  EXPECT_THAT(host.calls, ElementsAre("remove_queue /a@1", "remove_shm agnocast@10"));
+  EXPECT_THAT(host.calls, ElementsAre("remove_queue /a@1"));
   EXPECT_EQ(host.queues, std::set<std::string>{"stale@9"});  // left for the periodic sweep
 }
 
 TEST(HandleExitRecords, LostRecordsSweepAtOnce) {
   FakeHost host;
   // Queues of processes whose records were discarded, and a live one.
-  host.queues = {"a@1", "b@2", "live@3"};
+  host.queues = {"a@1", "b@2", "c@4", "live@3"};
   host.live = {"/live@3"};
-  host.shm = {"agnocast@20"};
   DeadProcessCollector collector;
   Counters counters;
   EXPECT_FALSE(handle_exit_records({queue_record(10, "/a", 1)}, collector, host, counters));
-  EXPECT_TRUE(handle_exit_records({lost_record(7), process_record(11)}, collector, host, counters));
+  EXPECT_TRUE(handle_exit_records({lost_record(7), queue_record(11, "/c", 4), process_record(11)},
+                                  collector, host, counters));
   EXPECT_EQ(host.queues, std::set<std::string>{"live@3"});
-  EXPECT_TRUE(host.shm.empty());
   EXPECT_EQ(counters.processes_cleaned, 1u);  // 11; 10's process record was lost
-  EXPECT_EQ(counters.queues_removed, 2u);
-  EXPECT_EQ(counters.shm_removed, 1u);
+  EXPECT_EQ(counters.queues_removed, 3u);
   // The sweep came after the cleanup of process 11.
   ASSERT_FALSE(host.calls.empty());
-  EXPECT_EQ(host.calls.front(), "remove_shm agnocast@11");
+  EXPECT_EQ(host.calls.front(), "remove_queue /c@4");
   EXPECT_EQ(collector.take_lost(), 0u);
   // A process record arriving after the loss no longer carries 10's queues.
   const auto later = collector.add({process_record(10)});

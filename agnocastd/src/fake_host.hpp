@@ -15,8 +15,6 @@ class FakeHost final : public Host {
  public:
   std::set<std::string> queues;  // file names in /dev/mqueue, "x@1"
   std::set<std::string> live;    // queue names, "/x@1"
-  std::set<std::string> shm;     // file names in /dev/shm
-  std::set<pid_t> alive;
   bool kernel_unreachable = false;
   std::vector<std::string> calls;               // the order of OS work, for order checks
   std::function<void()> between_list_and_live;  // runs after queue_files()
@@ -35,12 +33,6 @@ class FakeHost final : public Host {
   bool remove_queue(const std::string& name) override {
     calls.push_back("remove_queue " + name);
     return queues.erase(name.substr(1)) > 0;
-  }
-  std::vector<std::string> shm_files() override { return {shm.begin(), shm.end()}; }
-  bool process_alive(pid_t pid) override { return alive.contains(pid); }
-  bool remove_shm(const std::string& file) override {
-    calls.push_back("remove_shm " + file);
-    return shm.erase(file) > 0;
   }
 };
 

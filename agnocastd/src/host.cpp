@@ -2,9 +2,7 @@
 
 #include <dirent.h>
 #include <mqueue.h>
-#include <signal.h>
 #include <spdlog/spdlog.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -56,15 +54,6 @@ std::set<std::string> SystemHost::live_queues() {
 
 bool SystemHost::remove_queue(const std::string& name) {
   return removed(::mq_unlink(name.c_str()), "queue " + name);
-}
-
-std::vector<std::string> SystemHost::shm_files() { return list_directory("/dev/shm"); }
-
-bool SystemHost::process_alive(pid_t pid) { return ::kill(pid, 0) == 0 || errno != ESRCH; }
-
-bool SystemHost::remove_shm(const std::string& file) {
-  const std::string path = "/dev/shm/" + file;
-  return removed(::unlink(path.c_str()), path);
 }
 
 }  // namespace agnocastd

@@ -2,8 +2,6 @@
 // cleaner's and the sweeper's decisions are unit-tested with a fake.
 #pragma once
 
-#include <sys/types.h>
-
 #include <set>
 #include <string>
 #include <vector>
@@ -19,22 +17,14 @@ class Host {
   virtual std::set<std::string> live_queues() = 0;
   // mq_unlink(name); false when it did not exist (or could not be removed, logged).
   virtual bool remove_queue(const std::string& name) = 0;
-  // File names in /dev/shm.
-  virtual std::vector<std::string> shm_files() = 0;
-  virtual bool process_alive(pid_t pid) = 0;
-  // Removes /dev/shm/<file>; false when it did not exist (or could not be removed, logged).
-  virtual bool remove_shm(const std::string& file) = 0;
 };
 
-// The Host of this machine: /dev/mqueue, /dev/shm and the kernel module.
+// The Host of this machine: /dev/mqueue and the kernel module.
 class SystemHost final : public Host {
  public:
   std::vector<std::string> queue_files() override;
   std::set<std::string> live_queues() override;
   bool remove_queue(const std::string& name) override;
-  std::vector<std::string> shm_files() override;
-  bool process_alive(pid_t pid) override;
-  bool remove_shm(const std::string& file) override;
 };
 
 }  // namespace agnocastd

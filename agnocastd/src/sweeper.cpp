@@ -5,7 +5,6 @@
 #include <exception>
 
 #include "agnocast/naming.hpp"
-#include "cleaner.hpp"
 
 namespace agnocastd {
 
@@ -20,9 +19,7 @@ std::vector<std::string> stale_queues(const std::vector<std::string>& listed_fil
   return stale;
 }
 
-namespace {
-
-void sweep_queues(Host& host, Counters& counters) {
+void sweep(Host& host, Counters& counters) {
   const auto listed = host.queue_files();
   std::set<std::string> live;
   try {
@@ -37,24 +34,6 @@ void sweep_queues(Host& host, Counters& counters) {
       spdlog::info("removed stale queue {} (no live subscriber owns it)", queue);
     }
   }
-}
-
-void sweep_pool_objects(Host& host, Counters& counters) {
-  for (const auto& file : host.shm_files()) {
-    const auto pid = parse_pool_object_name(file);
-    if (!pid || host.process_alive(*pid)) continue;
-    if (host.remove_shm(file)) {
-      ++counters.shm_removed;
-      spdlog::info("removed stale shared memory /dev/shm/{} (process {} is gone)", file, *pid);
-    }
-  }
-}
-
-}  // namespace
-
-void sweep(Host& host, Counters& counters) {
-  sweep_queues(host, counters);
-  sweep_pool_objects(host, counters);
 }
 
 }  // namespace agnocastd

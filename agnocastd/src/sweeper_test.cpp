@@ -58,16 +58,5 @@ TEST(Sweep, RemovesNoQueueWhenTheKernelCannotBeAsked) {
   EXPECT_EQ(counters.queues_removed, 0u);
 }
 
-TEST(Sweep, RemovesPoolObjectsOfDeadPidsOnly) {
-  FakeHost host;
-  host.shm = {"agnocast@999999", "agnocast@42", "agnocast@x", "other@1", "agnocast@0"};
-  host.alive = {42};
-  Counters counters;
-  sweep(host, counters);
-  EXPECT_EQ(host.shm,
-            (std::set<std::string>{"agnocast@42", "agnocast@x", "other@1", "agnocast@0"}));
-  EXPECT_EQ(counters.shm_removed, 1u);
-}
-
 }  // namespace
 }  // namespace agnocastd

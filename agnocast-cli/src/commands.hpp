@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "agnocast/status.hpp"
 #include "cli.hpp"
 #include "inspection_source.hpp"
 
@@ -73,6 +74,13 @@ nlohmann::json process_list_json(InspectionSource& source);
 std::string process_list_table(const nlohmann::json& value);
 
 void set_daemon_command(CLI::App& app, Context& context);
+// agnocastd's status file as read: no status when it is absent (problem
+// empty) or unreadable (problem names the file and what is wrong with it).
+struct DaemonStatusRead {
+  std::optional<DaemonStatus> status;
+  std::string problem;
+};
+DaemonStatusRead read_daemon_status(InspectionSource& source, const std::string& status_path);
 // `status_path` is agnocastd's status file; its lock file sits beside it.
 nlohmann::json daemon_status_json(InspectionSource& source, const std::string& status_path);
 std::string daemon_status_table(const nlohmann::json& value);

@@ -347,6 +347,18 @@ TEST(Doctor, DaemonNotRunningFails) {
   EXPECT_FALSE(check_named(doctor_json(source, "/missing.json"), "daemon")["ok"].get<bool>());
 }
 
+TEST(Doctor, AStatusFileLackingAFieldIsNamed) {
+  FakeSource source = healthy_system();
+  source.files["/typo.json"] = R"({"running":true,"pdi":50})";
+  const json daemon = check_named(doctor_json(source, "/typo.json"), "daemon");
+  EXPECT_FALSE(daemon["ok"].get<bool>());
+  EXPECT_EQ(daemon["detail"],
+            "agnocastd is not running (/typo.json: agnocastd status file: \"pid\" is missing): "
+            "start it with `systemctl start agnocastd`");
+  EXPECT_EQ(check_named(doctor_json(source, "/missing.json"), "daemon")["detail"],
+            "agnocastd is not running: start it with `systemctl start agnocastd`");
+}
+
 TEST(Version, ModuleIsNullWhenNotLoaded) {
   FakeSource source;
   source.loaded = false;

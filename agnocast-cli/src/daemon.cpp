@@ -1,11 +1,10 @@
-// agnocast-cli daemon status: agnocastd's own status file (its path comes from
-// agnocastd's header), checked against its lock so a crashed daemon shows as stopped.
+// agnocast-cli daemon status: agnocastd's own status file (<agnocast/status.hpp>),
+// checked against its lock so a crashed daemon shows as stopped.
 #include <algorithm>
 #include <cstdint>
-#include <filesystem>
 
+#include "agnocast/status.hpp"
 #include "agnocast/version.hpp"
-#include "agnocastd/status_file.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -14,30 +13,15 @@ namespace {
 
 using nlohmann::json;
 
-const std::vector<std::string> counter_keys = {"uptime_s", "processes_cleaned", "queues_removed",
-                                               "shm_removed"};
-
-std::optional<json> read_status(InspectionSource& source, const std::string& path) {
-  const std::optional<std::string> text = source.read_file(path);
-  if (!text) return std::nullopt;
-  json status = json::parse(*text, nullptr, /*allow_exceptions=*/false);
-  if (!status.is_object() || !status.contains("pid") || !status["pid"].is_number_integer() ||
-      !status.contains("running") || !status["running"].is_boolean()) {
-    return std::nullopt;
-  }
-  return status;
-}
-
 // A daemon that crashed leaves "running":true behind. While it runs it holds
 // its lock file (beside the status file) exclusively; where that file cannot
 // be opened, its pid must be alive and, where /proc tells, be agnocastd.
-bool daemon_alive(InspectionSource& source, const json& status, const std::string& status_path) {
-  if (!status.at("running").get<bool>()) return false;
-  const std::string lock = (std::filesystem::path(status_path).parent_path() /
-                            std::filesystem::path(std::string(agnocastd::lock_path)).filename())
-                               .string();
+bool daemon_alive(InspectionSource& source, const DaemonStatus& status,
+                  const std::string& status_path) {
+  if (!status.running) return false;
+  const std::string lock = daemon_lock_path_beside(status_path);
   if (const std::optional<bool> locked = source.exclusively_locked(lock)) return *locked;
-  const pid_t pid = status.at("pid").get<pid_t>();
+  const pid_t pid = status.pid;
   if (!source.process_alive(pid)) return false;
   const std::optional<std::string> comm =
       source.read_file("/proc/" + std::to_string(pid) + "/comm");
@@ -45,35 +29,45 @@ bool daemon_alive(InspectionSource& source, const json& status, const std::strin
 }
 
 // uptime_s in the file is as of its last write; started_at gives it exactly.
-json uptime_of(InspectionSource& source, const json& status) {
-  if (status.contains("started_at") && status["started_at"].is_number()) {
-    const double uptime = source.unix_time() - status["started_at"].get<double>();
-    return static_cast<std::int64_t>(std::max(0.0, uptime));
-  }
-  return status.value("uptime_s", json(nullptr));
+std::int64_t uptime_of(InspectionSource& source, const DaemonStatus& status) {
+  const double uptime = source.unix_time() - static_cast<double>(status.started_at);
+  return static_cast<std::int64_t>(std::max(0.0, uptime));
 }
 
 }  // namespace
 
+DaemonStatusRead read_daemon_status(InspectionSource& source, const std::string& status_path) {
+  const std::optional<std::string> text = source.read_file(status_path);
+  if (!text) return {};
+  try {
+    return {daemon_status_from_json(*text), {}};
+  } catch (const StatusFormatError& error) {
+    return {std::nullopt, status_path + ": " + error.what()};
+  }
+}
+
 json daemon_status_json(InspectionSource& source, const std::string& status_path) {
-  const std::optional<json> status = read_status(source, status_path);
+  const std::optional<DaemonStatus> status = read_daemon_status(source, status_path).status;
   if (status && daemon_alive(source, *status, status_path)) {
-    json value = {{"running", true},
-                  {"pid", status->at("pid")},
-                  {"module_loaded", status->value("module_loaded", json(nullptr))},
-                  {"module_version", status->value("module_version", json(nullptr))}};
-    for (const std::string& key : counter_keys) value[key] = status->value(key, json(nullptr));
-    value["uptime_s"] = uptime_of(source, *status);
-    return value;
+    return {{"running", true},
+            {"pid", status->pid},
+            {"module_loaded", status->module_version.has_value()},
+            {"module_version", status->module_version ? json(*status->module_version) : json()},
+            {"uptime_s", uptime_of(source, *status)},
+            {"processes_cleaned", status->counters.processes_cleaned},
+            {"queues_removed", status->counters.queues_removed},
+            {"shm_removed", status->counters.shm_removed}};
   }
   // No daemon: what it would report about the module, the CLI sees for itself.
   const std::optional<Version> module = source.module_version();
-  json value = {{"running", false},
-                {"pid", nullptr},
-                {"module_loaded", module.has_value()},
-                {"module_version", module ? json(module->to_string()) : json(nullptr)}};
-  for (const std::string& key : counter_keys) value[key] = nullptr;
-  return value;
+  return {{"running", false},
+          {"pid", nullptr},
+          {"module_loaded", module.has_value()},
+          {"module_version", module ? json(module->to_string()) : json(nullptr)},
+          {"uptime_s", nullptr},
+          {"processes_cleaned", nullptr},
+          {"queues_removed", nullptr},
+          {"shm_removed", nullptr}};
 }
 
 std::string daemon_status_table(const json& value) {
@@ -84,7 +78,7 @@ std::string daemon_status_table(const json& value) {
 void set_daemon_command(CLI::App& app, Context& context) {
   CLI::App* daemon = app.add_subcommand("daemon", "The supervisor daemon agnocastd");
   daemon->require_subcommand(1);
-  auto status_path = std::make_shared<std::string>(agnocastd::status_path);
+  auto status_path = std::make_shared<std::string>(daemon_status_path);
   CLI::App* status = daemon->add_subcommand(
       "status", "Whether agnocastd runs, and what it has cleaned up (exit 0 either way)");
   status->add_option("--status-file", *status_path, "agnocastd's status file")

@@ -5,9 +5,10 @@
 #include <cstring>
 #include <sstream>
 
+#include "agnocast/inspect.hpp"
 #include "agnocast/naming.hpp"
+#include "agnocast/status.hpp"
 #include "agnocast/version.hpp"
-#include "agnocastd/status_file.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -16,7 +17,6 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* device_path = "/dev/agnocast";
 constexpr const char* start_daemon = "start it with `systemctl start agnocastd`";
 // Linux's defaults; a smaller limit means someone lowered it and queues will fail.
 constexpr long msg_max_minimum = 10;
@@ -36,7 +36,7 @@ std::optional<Version> try_module_version(InspectionSource& source, std::string&
 }
 
 json module_check(InspectionSource& source) {
-  if (source.path_exists("/sys/module/agnocast") || source.path_exists(device_path)) {
+  if (source.path_exists(module_sysfs_directory) || source.path_exists(device_path)) {
     return check("module", true, "agnocast.ko is loaded");
   }
   return check("module", false, std::string("agnocast.ko is not loaded: ") + start_daemon);
@@ -128,7 +128,10 @@ json mqueue_limits_check(InspectionSource& source) {
 json daemon_check(InspectionSource& source, const std::string& status_path) {
   const json status = daemon_status_json(source, status_path);
   if (!status.at("running").get<bool>()) {
-    return check("daemon", false, std::string("agnocastd is not running: ") + start_daemon);
+    const std::string problem = read_daemon_status(source, status_path).problem;
+    return check("daemon", false,
+                 "agnocastd is not running" + (problem.empty() ? "" : " (" + problem + ")") + ": " +
+                     start_daemon);
   }
   return check("daemon", true, "agnocastd is running as pid " + status.at("pid").dump());
 }
@@ -152,7 +155,7 @@ std::string doctor_table(const json& value) {
 }
 
 void set_doctor_command(CLI::App& app, Context& context) {
-  auto status_path = std::make_shared<std::string>(agnocastd::status_path);
+  auto status_path = std::make_shared<std::string>(daemon_status_path);
   CLI::App* doctor = app.add_subcommand(
       "doctor", "Check the module, device, versions, mqueue and daemon (exit 1 if any fails)");
   doctor->add_option("--status-file", *status_path, "agnocastd's status file")

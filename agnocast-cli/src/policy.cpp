@@ -2,6 +2,7 @@
 // this IPC namespace (agnocastd/README.md, "access"), with user and group ids shown by name.
 #include <string>
 
+#include "agnocast/access_policy.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -57,8 +58,7 @@ json policy_show_json(InspectionSource& source) {
 std::string policy_show_table(const json& value) {
   const json& policy = value.at("policy");
   if (policy.is_null()) {
-    return "no topic access policy: anyone with access to /dev/agnocast may publish and "
-           "subscribe\n";
+    return std::string(no_access_policy_meaning) + "\n";
   }
   std::string text = "default: " + policy.at("default").get<std::string>() +
                      " (topics no rule matches, and directions a rule leaves open)\n";

@@ -2,8 +2,10 @@
 // depth read with mq_getattr, and whether a live subscriber still owns it.
 #include <algorithm>
 #include <map>
+#include <utility>
 
 #include "agnocast/errors.hpp"
+#include "agnocast/inspect.hpp"
 #include "agnocast/naming.hpp"
 #include "commands.hpp"
 #include "table.hpp"
@@ -14,35 +16,29 @@ namespace {
 using nlohmann::json;
 using Align = Table::Align;
 
-struct Owner {
-  std::string topic;
-  pid_t pid = 0;
-};
-
 // Queue name -> the live callback subscriber it belongs to. Without the module
 // no subscriber can be alive, so every queue is then stale.
-std::map<std::string, Owner> queue_owners(InspectionSource& source) {
-  std::map<std::string, Owner> owners;
-  std::vector<TopicSummary> topics;
+std::map<std::string, QueueOwner> live_queue_owners(InspectionSource& source) {
+  std::vector<TopicSummary> summaries;
   try {
-    topics = source.list_topics();
+    summaries = source.list_topics();
   } catch (const ModuleNotLoaded&) {
-    return owners;
+    return {};
   }
-  for (const TopicSummary& summary : topics) {
-    const std::optional<TopicInfo> info = source.topic_info(summary.name);
-    if (!info) continue;  // the topic went away since it was listed
-    for (const SubscriberInfo& s : info->subscribers) {
-      if (!s.polling) owners.emplace(queue_name(info->name, s.id), Owner{info->name, s.pid});
+  std::vector<TopicInfo> topics;
+  for (const TopicSummary& summary : summaries) {
+    // nullopt: the topic went away since it was listed.
+    if (std::optional<TopicInfo> info = source.topic_info(summary.name)) {
+      topics.push_back(std::move(*info));
     }
   }
-  return owners;
+  return queue_owners(topics);
 }
 
 }  // namespace
 
 json queue_list_json(InspectionSource& source) {
-  const std::map<std::string, Owner> owners = queue_owners(source);
+  const std::map<std::string, QueueOwner> owners = live_queue_owners(source);
   std::vector<std::string> files = source.queue_files();
   std::sort(files.begin(), files.end());
   json queues = json::array();

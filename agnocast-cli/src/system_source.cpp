@@ -27,7 +27,7 @@ namespace {
 
 // "X.Y.Z" from the module's MODULE_VERSION, nullopt when absent or malformed.
 std::optional<Version> sysfs_module_version() {
-  std::ifstream in("/sys/module/agnocast/version");
+  std::ifstream in(std::string(module_sysfs_directory) + "/version");
   Version version;
   char dot1 = 0, dot2 = 0;
   if (in >> version.major >> dot1 >> version.minor >> dot2 >> version.patch && dot1 == '.' &&

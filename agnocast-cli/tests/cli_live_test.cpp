@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <agnocast_test/process.hpp>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -22,6 +23,12 @@
 
 namespace {
 
+using agnocast_test::become;
+using agnocast_test::eventually;
+using agnocast_test::slurp;
+using agnocast_test::spawn;
+using agnocast_test::stop;
+using agnocast_test::vm_agnocast_gid;
 using nlohmann::json;
 
 struct Outcome {
@@ -31,25 +38,16 @@ struct Outcome {
   json value() const { return json::parse(out); }
 };
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // Runs agnocast-cli ARGS through sh, as root or, with `uid`, as that user
 // with only the supplementary `groups`.
 Outcome cli(const std::string& args, uid_t uid = 0, const std::vector<gid_t>& groups = {}) {
   const std::string out = "cli-" + std::to_string(uid) + ".out";
   const std::string err = "cli-" + std::to_string(uid) + ".err";
   const std::string command = "agnocast-cli " + args + " >" + out + " 2>" + err;
+  const agnocast_test::Identity who{uid, uid, groups};
   const pid_t pid = ::fork();
   if (pid == 0) {
-    if (uid != 0 && (::setgroups(groups.size(), groups.data()) != 0 || ::setgid(uid) != 0 ||
-                     ::setuid(uid) != 0)) {
-      ::_exit(126);
-    }
+    if (uid != 0) become(who);
     ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
@@ -58,38 +56,8 @@ Outcome cli(const std::string& args, uid_t uid = 0, const std::vector<gid_t>& gr
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
 
-pid_t spawn(const std::vector<std::string>& args, const std::string& log) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
-    std::vector<char*> argv;
-    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
-    argv.push_back(nullptr);
-    ::execvp(argv[0], argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-void stop(pid_t& pid) {
-  if (pid <= 0) return;
-  ::kill(pid, SIGCONT);
-  ::kill(pid, SIGTERM);
-  ::waitpid(pid, nullptr, 0);
-  pid = -1;
-}
-
-// Polls `condition` every 100 ms for up to `seconds` (TCG is slow).
-bool eventually(const std::function<bool()>& condition, double seconds = 30) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return true;
-}
+// Under TCG the daemon and the endpoints take seconds to come up.
+constexpr std::chrono::seconds patience{30};
 
 // The element of `array` whose `key` equals `wanted`, or null.
 json find_by(const json& array, const std::string& key, const json& wanted) {
@@ -158,11 +126,14 @@ class CliLive : public ::testing::Test {
     stopped = spawn({"agnocast-listener", "--topic", topic, "--node", "stopped", "--depth", "10",
                      "--timeout", "600"},
                     "stopped.log");
-    ASSERT_TRUE(eventually([] {
-      const Outcome r = cli("topic list --json");
-      const json t = r.code == 0 ? find_by(r.value()["topics"], "name", topic) : json();
-      return !t.is_null() && t["subscribers"] == 2;
-    })) << "the listeners never subscribed";
+    ASSERT_TRUE(eventually(
+        [] {
+          const Outcome r = cli("topic list --json");
+          const json t = r.code == 0 ? find_by(r.value()["topics"], "name", topic) : json();
+          return !t.is_null() && t["subscribers"] == 2;
+        },
+        patience))
+        << "the listeners never subscribed";
     ASSERT_EQ(::kill(stopped, SIGSTOP), 0);
     talker = spawn({"agnocast-talker", "--topic", topic, "--node", "talker", "--depth", "10",
                     "--rate", "50", "--size", "1000"},
@@ -172,12 +143,15 @@ class CliLive : public ::testing::Test {
     ASSERT_GE(ghost, 0) << "cannot create /dev/mqueue/ghost@7";
     ::close(ghost);
     // Let the stopped listener's queue fill and its entries pile up.
-    ASSERT_TRUE(eventually([] {
-      const Outcome r = cli("topic info " + topic + " --json");
-      if (r.code != 0) return false;
-      const json s = find_by(r.value()["subscribers"], "pid", stopped);
-      return !s.is_null() && s["pending"] == 10 && s["unreceived"] == 10 && s["dropped"] > 0;
-    })) << slurp("cli-0.out");
+    ASSERT_TRUE(eventually(
+        [] {
+          const Outcome r = cli("topic info " + topic + " --json");
+          if (r.code != 0) return false;
+          const json s = find_by(r.value()["subscribers"], "pid", stopped);
+          return !s.is_null() && s["pending"] == 10 && s["unreceived"] == 10 && s["dropped"] > 0;
+        },
+        patience))
+        << slurp("cli-0.out");
   }
 
   static void TearDownTestSuite() {
@@ -369,14 +343,13 @@ TEST_F(CliLive, NodeListGroupsByProcess) {
 TEST_F(CliLive, AnUnprivilegedUserInspectsWhatItMayOpen) {
   ::chmod(".", 0777);  // that user writes its output files here
   constexpr uid_t nobody = 65534;
-  constexpr gid_t agnocast_group = 990;  // "agnocast" in the VM's /etc/group
   // The module creates the device 0660 root:root; the udev rule (or
   // agnocastd's device.group) gives it to group agnocast.
-  ASSERT_EQ(::chown("/dev/agnocast", 0, agnocast_group), 0);
+  ASSERT_EQ(::chown("/dev/agnocast", 0, vm_agnocast_gid), 0);
   const Outcome outsider = cli("topic list --json", nobody);
   EXPECT_EQ(outsider.code, 1);
   EXPECT_NE(outsider.err.find("group agnocast"), std::string::npos) << outsider.err;
-  const std::vector<gid_t> member{agnocast_group};
+  const std::vector<gid_t> member{vm_agnocast_gid};
   const Outcome policy = cli("policy show --json", nobody, member);
   ASSERT_EQ(policy.code, 0) << policy.err;
   EXPECT_EQ(policy.value(), json::parse(R"({"policy": null})"));
@@ -427,11 +400,13 @@ TEST_F(CliLive, DaemonStatusStoppedThenRunning) {
 
   // agnocastd sweeps stale queues: the ghost test above has already run.
   pid_t daemon = spawn({"agnocastd", "--no-load"}, "agnocastd.log");
-  ASSERT_TRUE(eventually([&] {
-    r = cli("daemon status --json");
-    return r.code == 0 && r.value()["running"] == true;
-  })) << r.out
-      << slurp("agnocastd.log");
+  ASSERT_TRUE(eventually(
+      [&] {
+        r = cli("daemon status --json");
+        return r.code == 0 && r.value()["running"] == true;
+      },
+      patience))
+      << r.out << slurp("agnocastd.log");
   const json status = r.value();
   EXPECT_EQ(status["pid"], daemon);
   EXPECT_EQ(status["module_loaded"], true);

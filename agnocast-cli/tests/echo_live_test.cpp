@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <agnocast/agnocast.hpp>
+#include <agnocast_test/process.hpp>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -46,6 +47,7 @@ AGNOCAST_MESSAGE(echo_live::Batch, "echo_live/msg/Batch", seq, head, samples, tr
 
 namespace {
 
+using agnocast_test::slurp;
 using nlohmann::json;
 
 struct Outcome {
@@ -53,13 +55,6 @@ struct Outcome {
   std::string out;
   std::string err;
 };
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 Outcome cli(const std::string& args) {
   const std::string command = "agnocast-cli " + args + " >echo.out 2>echo.err";

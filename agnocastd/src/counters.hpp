@@ -1,14 +1,10 @@
 // What agnocastd has removed since it started (shown by agnocast-cli daemon status).
 #pragma once
 
-#include <cstdint>
+#include "agnocast/status.hpp"
 
 namespace agnocastd {
 
-struct Counters {
-  std::uint64_t processes_cleaned = 0;
-  std::uint64_t queues_removed = 0;
-  std::uint64_t shm_removed = 0;
-};
+using Counters = agnocast::DaemonCounters;
 
 }  // namespace agnocastd

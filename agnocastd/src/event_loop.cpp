@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "agnocast/inspect.hpp"
+#include "agnocast/status.hpp"
 #include "daemon_signals.hpp"
 #include "errno_error.hpp"
 #include "module_loader.hpp"
@@ -97,7 +98,7 @@ bool reload_config(Supervisor& supervisor) {
 
 void write_status(const Supervisor& supervisor, bool running) {
   using std::chrono::duration_cast;
-  Status status;
+  agnocast::DaemonStatus status;
   status.running = running;
   status.pid = ::getpid();
   status.module_version = supervisor.module_version;
@@ -108,7 +109,7 @@ void write_status(const Supervisor& supervisor, bool running) {
       duration_cast<std::chrono::seconds>(supervisor.started_at.time_since_epoch()).count();
   status.counters = supervisor.counters;
   try {
-    write_status_file(supervisor.status_path, status_json(status));
+    write_status_file(supervisor.status_path, agnocast::to_json(status));
   } catch (const std::exception& error) {
     spdlog::error("cannot write the status file: {}", error.what());
   }

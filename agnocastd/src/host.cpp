@@ -42,13 +42,7 @@ std::vector<std::string> SystemHost::queue_files() {
 
 std::set<std::string> SystemHost::live_queues() {
   std::set<std::string> queues;
-  for (const auto& topic : agnocast::list_topics()) {
-    const auto info = agnocast::topic_info(topic.name);
-    if (!info) continue;  // its last endpoint left since list_topics
-    for (const auto& subscriber : info->subscribers) {
-      if (!subscriber.polling) queues.insert(agnocast::queue_name(info->name, subscriber.id));
-    }
-  }
+  for (const auto& [queue, owner] : agnocast::live_queue_owners()) queues.insert(queue);
   return queues;
 }
 

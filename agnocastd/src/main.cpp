@@ -9,8 +9,8 @@
 #include <optional>
 
 #include "agnocast/inspect.hpp"
+#include "agnocast/status.hpp"
 #include "agnocast/supervise.hpp"
-#include "agnocastd/status_file.hpp"
 #include "config.hpp"
 #include "daemon_signals.hpp"
 #include "event_loop.hpp"
@@ -120,7 +120,7 @@ void stop_module(bool loaded_here, bool unload_on_exit) {
 
 int run(const agnocastd::Config& config, std::function<agnocastd::Config()> reread_config) {
   // One daemon at a time, before touching anything.
-  agnocastd::InstanceLock lock{std::string(agnocastd::lock_path)};
+  agnocastd::InstanceLock lock{std::string(agnocast::daemon_lock_path)};
   // Stop signals queue up from here on; serve() reads them.
   agnocastd::block_daemon_signals();
   // The module, its version and the device permissions: clients need all three.
@@ -145,7 +145,7 @@ int run(const agnocastd::Config& config, std::function<agnocastd::Config()> rere
                                      std::move(reread_config),
                                      host,
                                      exit_records,
-                                     std::string(agnocastd::status_path),
+                                     std::string(agnocast::daemon_status_path),
                                      module_version};
     // What died while no daemon ran: first the exits the kernel recorded, then the rest.
     agnocastd::clean_exited_processes(supervisor);

@@ -11,6 +11,7 @@
 #include <system_error>
 #include <vector>
 
+#include "agnocast/inspect.hpp"
 #include "child_process.hpp"
 #include "daemon_signals.hpp"
 
@@ -18,11 +19,11 @@ namespace agnocastd {
 
 namespace {
 constexpr const char* module_name = "agnocast";
-constexpr const char* device_path = "/dev/agnocast";
+using agnocast::device_path;
 }  // namespace
 
 bool module_present() {
-  return ::access("/sys/module/agnocast", F_OK) == 0 || ::access(device_path, F_OK) == 0;
+  return ::access(agnocast::module_sysfs_directory, F_OK) == 0 || ::access(device_path, F_OK) == 0;
 }
 
 std::string module_parameter_string(const std::map<std::string, std::string>& parameters) {

@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 
+#include "agnocast/inspect.hpp"
 #include "child_process.hpp"
 #include "config.hpp"
 
@@ -107,11 +108,14 @@ std::string declared_names(const DeclaredParameters& declared) {
   return names.empty() ? "none" : names;
 }
 
-constexpr const char* parameters_directory = "/sys/module/agnocast/parameters";
+std::string parameters_directory() {
+  return std::string(agnocast::module_sysfs_directory) + "/parameters";
+}
 
 std::vector<std::string> parameter_files() {
   std::vector<std::string> names;
-  const std::unique_ptr<DIR, int (*)(DIR*)> dir(::opendir(parameters_directory), ::closedir);
+  const std::unique_ptr<DIR, int (*)(DIR*)> dir(::opendir(parameters_directory().c_str()),
+                                                ::closedir);
   if (!dir) return names;
   while (const dirent* entry = ::readdir(dir.get())) {
     const std::string name = entry->d_name;
@@ -188,7 +192,7 @@ std::optional<DeclaredParameters> declared_module_parameters(
 ParameterValues loaded_module_parameters() {
   ParameterValues values;
   for (const auto& name : parameter_files()) {
-    std::ifstream file(std::string(parameters_directory) + "/" + name);
+    std::ifstream file(parameters_directory() + "/" + name);
     std::string value;
     if (file && std::getline(file, value)) values[name] = std::string(trimmed(value));
   }

@@ -5,6 +5,7 @@
 #include <exception>
 #include <map>
 
+#include "agnocast/access_policy.hpp"
 #include "module_loader.hpp"
 #include "mqueue_setup.hpp"
 
@@ -44,9 +45,7 @@ void apply_access_policy(const std::optional<agnocast::AccessPolicy>& policy) {
     spdlog::info("topic access policy in force: {} rule(s), default {}", policy->rules.size(),
                  policy->default_allow ? "allow" : "deny");
   } else {
-    spdlog::info(
-        "no topic access policy: anyone with access to /dev/agnocast may publish and "
-        "subscribe");
+    spdlog::info("{}", agnocast::no_access_policy_meaning);
   }
 }
 

@@ -12,22 +12,7 @@
 
 namespace agnocastd {
 
-nlohmann::json status_json(const Status& status) {
-  return {
-      {"running", status.running},
-      {"pid", status.pid},
-      {"module_loaded", status.module_version.has_value()},
-      {"module_version",
-       status.module_version ? nlohmann::json(*status.module_version) : nlohmann::json(nullptr)},
-      {"uptime_s", status.uptime_s},
-      {"started_at", status.started_at},
-      {"processes_cleaned", status.counters.processes_cleaned},
-      {"queues_removed", status.counters.queues_removed},
-      {"shm_removed", status.counters.shm_removed},
-  };
-}
-
-void write_status_file(const std::string& path, const nlohmann::json& status) {
+void write_status_file(const std::string& path, const std::string& text) {
   const std::filesystem::path target(path);
   if (target.has_parent_path() && !std::filesystem::exists(target.parent_path())) {
     std::filesystem::create_directories(target.parent_path());
@@ -36,7 +21,6 @@ void write_status_file(const std::string& path, const nlohmann::json& status) {
   const std::string temporary = path + ".tmp";
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw_errno("cannot create " + temporary);
-  const std::string text = status.dump() + "\n";
   // fchmod: the umask must not make the file unreadable for the CLI.
   const bool written = ::fchmod(fd, 0644) == 0 &&
                        ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());

@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <agnocast/agnocast.hpp>
+#include <agnocast/status.hpp>
+#include <agnocast_test/process.hpp>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
@@ -24,67 +26,24 @@
 
 namespace {
 
+using agnocast_test::become;
+using agnocast_test::eventually;
+using agnocast_test::Identity;
+using agnocast_test::slurp;
+using agnocast_test::spawn;
+using agnocast_test::vm_agnocast_gid;
+using agnocast_test::wait_exit;
+using agnocast_test::write_file;
 using nlohmann::json;
 using namespace std::chrono_literals;
 
-constexpr gid_t agnocast_gid = 990;  // "agnocast" in the VM's /etc/group
-constexpr gid_t safety_gid = 3000;   // no name: the config uses "group:3000"
+constexpr gid_t safety_gid = 3000;  // no name: the config uses "group:3000"
 
-struct Identity {
-  uid_t uid;
-  gid_t gid;
-  std::vector<gid_t> groups;
-};
-const Identity safety_member{2001, 2001, {agnocast_gid, safety_gid}};
-const Identity outsider{2002, 2002, {agnocast_gid}};
+const Identity safety_member{2001, 2001, {vm_agnocast_gid, safety_gid}};
+const Identity outsider{2002, 2002, {vm_agnocast_gid}};
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void write_file(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
-
-// In a forked child: become `who`; exits 126 when that fails.
-void become(const Identity& who) {
-  if (::setgroups(who.groups.size(), who.groups.data()) != 0 || ::setgid(who.gid) != 0 ||
-      ::setuid(who.uid) != 0) {
-    ::_exit(126);
-  }
-}
-
-pid_t spawn(const Identity* who, const std::vector<std::string>& args, const std::string& log) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
-    if (who) become(*who);
-    std::vector<char*> argv;
-    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
-    argv.push_back(nullptr);
-    ::execvp(argv[0], argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-int wait_exit(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit = 10s) {
-  const auto deadline = std::chrono::steady_clock::now() + limit;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(50ms);
-  }
-  return true;
-}
+// How long the daemon, the endpoints and a reload may take.
+constexpr std::chrono::seconds patience = 10s;
 
 // The topics' type: the talker's and listener's message.
 using Sample = chatter::Message;
@@ -129,7 +88,7 @@ json cli_json(const Identity* who, const std::vector<std::string>& args) {
   std::vector<std::string> command{"agnocast-cli"};
   command.insert(command.end(), args.begin(), args.end());
   command.push_back("--json");
-  const int code = wait_exit(spawn(who, command, "cli.out"));
+  const int code = wait_exit(spawn(command, "cli.out", who));
   const std::string out = slurp("cli.out");
   return code == 0 && json::accept(out) ? json::parse(out) : json();
 }
@@ -155,7 +114,7 @@ std::size_t occurrences(const std::string& text) {
 }
 
 bool daemon_ready(pid_t daemon) {
-  const std::string status = slurp("/run/agnocast/agnocastd.json");
+  const std::string status = slurp(std::string(agnocast::daemon_status_path));
   if (!json::accept(status)) return false;
   const json value = json::parse(status);
   return value.value("pid", 0) == daemon && value.value("running", false);
@@ -172,8 +131,8 @@ const char* bad_policy = R"({"device": {"group": "agnocast"},
 
 TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
   write_file("agnocastd.json", policy_a);
-  const pid_t daemon = spawn(nullptr, {"agnocastd", "--config", "agnocastd.json"}, "agnocastd.log");
-  ASSERT_TRUE(eventually([&] { return daemon_ready(daemon); })) << slurp("agnocastd.log");
+  const pid_t daemon = spawn({"agnocastd", "--config", "agnocastd.json"}, "agnocastd.log");
+  ASSERT_TRUE(eventually([&] { return daemon_ready(daemon); }, patience)) << slurp("agnocastd.log");
 
   // Policy A: only group 3000 publishes /safety/**; the default allows the rest.
   std::string why;
@@ -189,23 +148,22 @@ TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
 
   // Endpoints made under policy A, kept across the reload.
   const pid_t talker =
-      spawn(&safety_member,
-            {"agnocast-talker", "--topic", "/safety/brake", "--rate", "100", "--linger", "0"},
-            "talker.log");
-  const pid_t listener = spawn(
-      &safety_member, {"agnocast-listener", "--topic", "/safety/brake", "--json"}, "listener.log");
+      spawn({"agnocast-talker", "--topic", "/safety/brake", "--rate", "100", "--linger", "0"},
+            "talker.log", &safety_member);
+  const pid_t listener = spawn({"agnocast-listener", "--topic", "/safety/brake", "--json"},
+                               "listener.log", &safety_member);
   const auto published = [] {
     const json info = cli_json(nullptr, {"topic", "info", "/safety/brake"});
     return info.is_object() && !info["publishers"].empty()
                ? info["publishers"][0].value("published", std::uint64_t{0})
                : std::uint64_t{0};
   };
-  ASSERT_TRUE(eventually([&] { return published() > 20; })) << slurp("talker.log");
+  ASSERT_TRUE(eventually([&] { return published() > 20; }, patience)) << slurp("talker.log");
 
   // Policy B: only user 2002 publishes /safety/**; the default denies the rest.
   write_file("agnocastd.json", policy_b);
   ::kill(daemon, SIGHUP);
-  ASSERT_TRUE(eventually([] { return log_has("configuration reloaded"); }))
+  ASSERT_TRUE(eventually([] { return log_has("configuration reloaded"); }, patience))
       << slurp("agnocastd.log");
   const std::uint64_t published_at_reload = published();
   EXPECT_EQ(policy_shown(&outsider), json::parse(R"({"policy": {"default": "deny", "rules": [
@@ -219,7 +177,7 @@ TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
   // A bad file: logged, and policy B stays.
   write_file("agnocastd.json", bad_policy);
   ::kill(daemon, SIGHUP);
-  ASSERT_TRUE(eventually([] { return log_has("no group named 'no_such_group_zz'"); }))
+  ASSERT_TRUE(eventually([] { return log_has("no group named 'no_such_group_zz'"); }, patience))
       << slurp("agnocastd.log");
   EXPECT_TRUE(log_has("[error] configuration not reloaded")) << slurp("agnocastd.log");
   EXPECT_EQ(occurrences("configuration reloaded"), 1u);
@@ -229,7 +187,7 @@ TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
 
   // The talker and listener of policy A kept working: messages published
   // after the reload reached the listener.
-  ASSERT_TRUE(eventually([&] { return published() > published_at_reload + 50; }));
+  ASSERT_TRUE(eventually([&] { return published() > published_at_reload + 50; }, patience));
   ::kill(listener, SIGINT);
   EXPECT_EQ(wait_exit(listener), 0) << slurp("listener.log");
   ::kill(talker, SIGINT);

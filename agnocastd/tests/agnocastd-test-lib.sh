@@ -2,6 +2,7 @@
 # loaded). Each test runs in its own working directory; the daemon's log is
 # ./agnocastd.log there.
 set -u
+. /opt/agnocast/bin/vm-test-lib.sh
 status_file=/run/agnocast/agnocastd.json
 daemon_pid=
 
@@ -10,20 +11,6 @@ fail() {
 	[ -f agnocastd.log ] && sed 's/^/  agnocastd| /' agnocastd.log
 	[ -n "$daemon_pid" ] && kill -9 "$daemon_pid" 2>/dev/null
 	exit 1
-}
-
-# Hundredths of a second since boot.
-now_cs() { sed 's/^\([0-9]*\)\.\([0-9]*\) .*/\1\2/' /proc/uptime; }
-
-# wait_until SECONDS COMMAND...: polls COMMAND every 50 ms; false after SECONDS.
-wait_until() {
-	limit_cs=$(($1 * 100)); shift
-	start_cs=$(now_cs)
-	while ! "$@"; do
-		[ $(($(now_cs) - start_cs)) -ge "$limit_cs" ] && return 1
-		sleep 0.05
-	done
-	waited_ms=$((($(now_cs) - start_cs) * 10))
 }
 
 # The value of a numeric or boolean field of the status file.

@@ -16,8 +16,12 @@
 
 #include "agnocast/access_policy.hpp"
 #include "agnocast/errors.hpp"
+#include "agnocast/inspect.hpp"
 
 namespace agnocast {
+
+static_assert(std::string_view(device_path) == AGNOCAST_DEVICE_PATH,
+              "inspect.hpp's device_path is the UAPI's");
 
 ModuleNotLoaded::ModuleNotLoaded()
     : Error("agnocast kernel module is not loaded (" AGNOCAST_DEVICE_PATH

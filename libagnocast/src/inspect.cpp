@@ -2,12 +2,27 @@
 
 #include <unistd.h>
 
+#include <utility>
+
 #include "agnocast/errors.hpp"
+#include "agnocast/naming.hpp"
 #include "device.hpp"
 
 namespace agnocast {
 
-bool module_loaded() { return ::access("/dev/agnocast", F_OK) == 0; }
+std::map<std::string, QueueOwner> queue_owners(const std::vector<TopicInfo>& topics) {
+  std::map<std::string, QueueOwner> owners;
+  for (const TopicInfo& topic : topics) {
+    for (const SubscriberInfo& subscriber : topic.subscribers) {
+      if (subscriber.polling) continue;
+      owners.emplace(queue_name(topic.name, subscriber.id),
+                     QueueOwner{topic.name, subscriber.id, subscriber.pid});
+    }
+  }
+  return owners;
+}
+
+bool module_loaded() { return ::access(device_path, F_OK) == 0; }
 
 std::optional<Version> module_version() {
   try {
@@ -29,6 +44,16 @@ std::vector<ProcessInfo> list_processes() { return detail::Device::open().list_p
 
 std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic) {
   return detail::Device::open().topic_schema(topic);
+}
+
+std::map<std::string, QueueOwner> live_queue_owners() {
+  std::vector<TopicInfo> topics;
+  for (const TopicSummary& summary : list_topics()) {
+    // nullopt: its last endpoint left since list_topics.
+    if (std::optional<TopicInfo> info = topic_info(summary.name))
+      topics.push_back(std::move(*info));
+  }
+  return queue_owners(topics);
 }
 
 }  // namespace agnocast

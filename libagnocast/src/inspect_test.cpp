@@ -32,6 +32,31 @@ TEST_F(WithoutModule, QueriesThrowModuleNotLoadedWithAdvice) {
   EXPECT_THROW(topic_info("/chatter"), ModuleNotLoaded);
   EXPECT_THROW(list_processes(), ModuleNotLoaded);
   EXPECT_THROW(ExitRecordReader{}, ModuleNotLoaded);
+  EXPECT_THROW(live_queue_owners(), ModuleNotLoaded);
+}
+
+SubscriberInfo subscriber(std::uint32_t id, pid_t pid, bool polling = false) {
+  SubscriberInfo info;
+  info.id = id;
+  info.pid = pid;
+  info.polling = polling;
+  return info;
+}
+
+TEST(QueueOwners, EveryCallbackSubscriberOwnsItsQueueAndPollingOnesNone) {
+  TopicInfo chatter;
+  chatter.name = "/a/chatter";
+  chatter.subscribers = {subscriber(1, 10), subscriber(2, 20, /*polling=*/true)};
+  TopicInfo status;
+  status.name = "/status";
+  status.subscribers = {subscriber(7, 30)};
+  const std::map<std::string, QueueOwner> owners = queue_owners({chatter, status, TopicInfo{}});
+  ASSERT_EQ(owners.size(), 2u);
+  EXPECT_EQ(owners.at("/a_chatter@1").topic, "/a/chatter");
+  EXPECT_EQ(owners.at("/a_chatter@1").subscriber_id, 1u);
+  EXPECT_EQ(owners.at("/a_chatter@1").pid, 10);
+  EXPECT_EQ(owners.at("/status@7").topic, "/status");
+  EXPECT_EQ(owners.at("/status@7").pid, 30);
 }
 
 TEST(LibraryVersion, IsTheProjectVersionAndCompatibilityIsMajorMinor) {

@@ -55,6 +55,10 @@ std::string to_string(const TopicPattern& pattern);
 // Whether a topic matches, with the kernel's semantics (for tools and tests).
 bool matches(const TopicPattern& pattern, std::string_view topic);
 
+// What having no policy means, as the daemon logs it and the CLI shows it.
+inline constexpr std::string_view no_access_policy_meaning =
+    "no topic access policy: anyone with access to /dev/agnocast may publish and subscribe";
+
 // The policy in force in this process's IPC namespace; nullopt when none.
 // Anyone who can open /dev/agnocast may read it.
 std::optional<AccessPolicy> access_policy();

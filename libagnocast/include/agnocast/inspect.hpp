@@ -6,6 +6,7 @@
 #include <sys/types.h>
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,6 +14,12 @@
 #include "agnocast/version.hpp"
 
 namespace agnocast {
+
+// The device the module creates (the UAPI's AGNOCAST_DEVICE_PATH); C strings
+// for the system calls that take them.
+inline constexpr char device_path[] = "/dev/agnocast";
+// There as soon as the module is in the kernel, before the device appears.
+inline constexpr char module_sysfs_directory[] = "/sys/module/agnocast";
 
 struct TopicSummary {
   std::string name;
@@ -67,6 +74,17 @@ struct ProcessInfo {
   std::uint64_t pool_size = 0;
 };
 
+// The callback subscriber a notification queue belongs to.
+struct QueueOwner {
+  std::string topic;
+  std::uint32_t subscriber_id = 0;
+  pid_t pid = 0;
+};
+
+// Queue name ("/a_b@3") -> its owner, for every callback subscriber of
+// `topics` (a polling subscriber owns no queue): the queues that are live.
+std::map<std::string, QueueOwner> queue_owners(const std::vector<TopicInfo>& topics);
+
 // True when /dev/agnocast exists.
 bool module_loaded();
 // The loaded module's version, nullopt when it is not loaded.
@@ -78,5 +96,7 @@ std::vector<ProcessInfo> list_processes();
 // The schema blob the topic's endpoints registered (see schema.hpp);
 // nullopt when it has none or no such topic has an endpoint.
 std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic);
+// queue_owners() of every topic the module lists now.
+std::map<std::string, QueueOwner> live_queue_owners();
 
 }  // namespace agnocast

@@ -1,0 +1,97 @@
+// What the in-VM C++ tests share: files, child processes run as other users,
+// polling for a condition, and the test bed's agnocast group.
+#pragma once
+
+#include <fcntl.h>
+#include <grp.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace agnocast_test {
+
+// The group "agnocast" of the VM's /etc/group (tests/vm/run-vm-suite).
+inline constexpr gid_t vm_agnocast_gid = 990;
+
+// The whole file; empty when it cannot be read.
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+inline void write_file(const std::string& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+// Who a child process becomes: uid, primary gid and supplementary groups.
+struct Identity {
+  uid_t uid;
+  gid_t gid;
+  std::vector<gid_t> groups;
+};
+
+// In a forked child: become `who`; exits 126 when that fails.
+inline void become(const Identity& who) {
+  if (::setgroups(who.groups.size(), who.groups.data()) != 0 || ::setgid(who.gid) != 0 ||
+      ::setuid(who.uid) != 0) {
+    ::_exit(126);
+  }
+}
+
+// Runs args[0] from PATH with stdout and stderr into `log` (created before
+// becoming `who`, when given); exit status 127 when it cannot be run.
+inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
+                   const Identity* who = nullptr) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, STDOUT_FILENO);
+    ::dup2(fd, STDERR_FILENO);
+    if (who) become(*who);
+    std::vector<char*> argv;
+    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+    argv.push_back(nullptr);
+    ::execvp(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// The exit status, or 128 + the signal that ended it.
+inline int wait_exit(pid_t pid) {
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Ends a child that may be stopped (SIGCONT, SIGTERM, reaped); pid becomes -1.
+inline void stop(pid_t& pid) {
+  if (pid <= 0) return;
+  ::kill(pid, SIGCONT);
+  ::kill(pid, SIGTERM);
+  ::waitpid(pid, nullptr, 0);
+  pid = -1;
+}
+
+// Polls `condition` every 50 ms until it holds (true) or `limit` passed (false).
+inline bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return true;
+}
+
+}  // namespace agnocast_test

@@ -1,0 +1,18 @@
+# Helpers every in-VM shell test may source (busybox sh):
+#   . /opt/agnocast/bin/vm-test-lib.sh
+
+# Hundredths of a second since boot.
+now_cs() { sed 's/^\([0-9]*\)\.\([0-9]*\) .*/\1\2/' /proc/uptime; }
+
+# wait_until SECONDS COMMAND...: polls COMMAND every 50 ms; false after
+# SECONDS. On success waited_ms says how long it took.
+wait_until() {
+	limit_cs=$(($1 * 100)); shift
+	start_cs=$(now_cs)
+	while ! "$@"; do
+		[ $(($(now_cs) - start_cs)) -ge "$limit_cs" ] && return 1
+		sleep 0.05
+	done
+	waited_ms=$((($(now_cs) - start_cs) * 10))
+	return 0
+}

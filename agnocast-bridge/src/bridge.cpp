@@ -193,12 +193,16 @@ int serve(const Config& config, const TypeRegistry& types) {
   agnocast::Node node(node_name);
   OwnPool own_pool;
   std::vector<BridgedTopic> topics;
-  for (const auto& topic : config.topics) {
+  for (std::size_t i = 0; i < config.topics.size(); ++i) {
+    const TopicConfig& topic = config.topics[i];
     auto counters = std::make_unique<TopicCounters>();
     const RelayContext context{topic, node, domain, own_pool, *counters};
     try {
       auto relay = types.make(topic.type, topic.direction, context);
       topics.push_back(BridgedTopic{&topic, std::move(counters), std::move(relay)});
+    } catch (const std::invalid_argument& error) {
+      // The library refused what the topic asks for: a restart cannot fix it.
+      throw ConfigError("topics[" + std::to_string(i) + "]", error.what());
     } catch (const std::exception& error) {
       throw std::runtime_error("topic " + topic.name + " (" +
                                std::string(direction_name(topic.direction)) + "): " + error.what());
@@ -277,6 +281,10 @@ int run_bridge(int argc, char** argv, const TypeRegistry& types) {
   }
   try {
     return serve(config, types);
+  } catch (const ConfigError& error) {
+    std::cerr << "agnocast-bridge: bad configuration " << config_path << ": " << error.what()
+              << std::endl;
+    return 2;
   } catch (const DdsError& error) {
     std::cerr << "agnocast-bridge: " << error.what() << std::endl;
   } catch (const std::exception& error) {

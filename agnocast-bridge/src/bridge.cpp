@@ -23,7 +23,6 @@
 #include "config.hpp"
 #include "dds_domain.hpp"
 #include "notify.hpp"
-#include "own_pool.hpp"
 #include "status_file.hpp"
 
 namespace agnocast_bridge {
@@ -55,7 +54,8 @@ void check_types(const Config& config, const TypeRegistry& types) {
   }
 }
 
-// One bridge per machine: its loop protection relies on seeing its own messages.
+// One bridge per machine: its loop protection recognizes only its own
+// process's publications, and two bridges would relay each other's.
 class InstanceLock {
  public:
   explicit InstanceLock(const std::string& path) {
@@ -191,20 +191,22 @@ int serve(const Config& config, const TypeRegistry& types) {
   const auto started_at = static_cast<std::int64_t>(std::time(nullptr));
 
   agnocast::Node node(node_name);
-  OwnPool own_pool;
   std::vector<BridgedTopic> topics;
-  for (const auto& topic : config.topics) {
+  for (std::size_t i = 0; i < config.topics.size(); ++i) {
+    const TopicConfig& topic = config.topics[i];
     auto counters = std::make_unique<TopicCounters>();
-    const RelayContext context{topic, node, domain, own_pool, *counters};
+    const RelayContext context{topic, node, domain, *counters};
     try {
       auto relay = types.make(topic.type, topic.direction, context);
       topics.push_back(BridgedTopic{&topic, std::move(counters), std::move(relay)});
+    } catch (const std::invalid_argument& error) {
+      // The library refused what the topic asks for: a restart cannot fix it.
+      throw ConfigError("topics[" + std::to_string(i) + "]", error.what());
     } catch (const std::exception& error) {
       throw std::runtime_error("topic " + topic.name + " (" +
                                std::string(direction_name(topic.direction)) + "): " + error.what());
     }
   }
-  if (!topics.empty()) own_pool.locate();
 
   agnocast::SingleThreadedExecutor executor;
   executor.add_node(node);
@@ -277,6 +279,10 @@ int run_bridge(int argc, char** argv, const TypeRegistry& types) {
   }
   try {
     return serve(config, types);
+  } catch (const ConfigError& error) {
+    std::cerr << "agnocast-bridge: bad configuration " << config_path << ": " << error.what()
+              << std::endl;
+    return 2;
   } catch (const DdsError& error) {
     std::cerr << "agnocast-bridge: " << error.what() << std::endl;
   } catch (const std::exception& error) {

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "agnocast/limits.hpp"
 #include "agnocast/naming.hpp"
 #include "dds_names.hpp"
 
@@ -16,8 +17,8 @@ using nlohmann::json;
 
 // DDS maps domain ids to UDP ports; 232 is the largest the default mapping allows.
 constexpr std::uint32_t max_domain_id = 232;
-// Bounded by what the kernel keeps per publisher and by memory for DDS histories.
-constexpr std::size_t max_depth = 65536;
+// Every other bound is the library's (<agnocast/limits.hpp>): what the
+// configuration check accepts, the library accepts when the bridge starts.
 
 void refuse_unknown_keys(const json& object, const std::string& where,
                          std::initializer_list<std::string_view> known) {
@@ -54,10 +55,12 @@ TopicQos parse_qos(const json& object, const std::string& where) {
   refuse_unknown_keys(object, where, {"depth", "reliable", "transient_local"});
   TopicQos qos;
   if (const auto depth = object.find("depth"); depth != object.end()) {
-    if (!depth->is_number_unsigned() || depth->get<std::uint64_t>() < 1 ||
-        depth->get<std::uint64_t>() > max_depth) {
-      throw ConfigError(where + ".depth",
-                        "must be an integer from 1 to " + std::to_string(max_depth));
+    // The agnocast depth, and the DDS history depth, which is no longer.
+    if (!depth->is_number_unsigned() || depth->get<std::uint64_t>() < agnocast::qos_depth_min ||
+        depth->get<std::uint64_t>() > agnocast::qos_depth_max) {
+      throw ConfigError(where + ".depth", "must be an integer from " +
+                                              std::to_string(agnocast::qos_depth_min) + " to " +
+                                              std::to_string(agnocast::qos_depth_max));
     }
     qos.depth = depth->get<std::size_t>();
   }
@@ -75,6 +78,11 @@ TopicConfig parse_topic(const json& object, const std::string& where) {
     throw ConfigError(where + ".name", problem);
   }
   topic.type = require_string(object, where, "type");
+  if (topic.type.size() > agnocast::type_name_max) {
+    throw ConfigError(where + ".type", "message type name '" + topic.type +
+                                           "' is too long: at most " +
+                                           std::to_string(agnocast::type_name_max) + " characters");
+  }
   try {
     dds_type_name(topic.type);
   } catch (const std::invalid_argument& error) {

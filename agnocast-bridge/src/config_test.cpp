@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "agnocast/limits.hpp"
+
 namespace agnocast_bridge {
 namespace {
 
@@ -70,6 +72,45 @@ TEST(Config, ErrorsNameTheKey) {
   EXPECT_EQ(error_key(R"({"topics": [{)" + topic +
                       R"(}, {"name": "/t", "type": "a/msg/B", "direction": "from_dds"}]})"),
             "topics[1].type");
+}
+
+std::string with_depth(const std::string& depth) {
+  return R"({"topics": [{"name": "/t", "type": "std_msgs/msg/Header", "direction": "to_dds"},
+                        {"name": "/u", "type": "std_msgs/msg/Header", "direction": "from_dds",
+                         "qos": {"depth": )" +
+         depth + "}}]}";
+}
+
+// The bounds are the library's: a depth the check accepts is one the library
+// accepts when the bridge creates its endpoints.
+TEST(Config, DepthIsWithinTheLibrarysLimits) {
+  EXPECT_EQ(agnocast::qos_depth_min, 1u);
+  EXPECT_EQ(parse_config(with_depth("1")).topics[1].qos.depth, 1u);
+  EXPECT_EQ(parse_config(with_depth(std::to_string(agnocast::qos_depth_max))).topics[1].qos.depth,
+            agnocast::qos_depth_max);
+  for (const std::string& depth :
+       {std::string("0"), std::to_string(agnocast::qos_depth_max + 1), std::string("2000"),
+        std::string("65536"), std::string("-1"), std::string("1.5"), std::string("\"10\"")}) {
+    try {
+      parse_config(with_depth(depth));
+      ADD_FAILURE() << "depth " << depth << " accepted";
+    } catch (const ConfigError& error) {
+      EXPECT_EQ(error.key(), "topics[1].qos.depth") << depth;
+      EXPECT_STREQ(error.what(), ("topics[1].qos.depth: must be an integer from 1 to " +
+                                  std::to_string(agnocast::qos_depth_max))
+                                     .c_str());
+    }
+  }
+}
+
+TEST(Config, TypeNameLengthIsTheLibrarys) {
+  const auto config_with_type = [](const std::string& type) {
+    return R"({"topics": [{"name": "/t", "direction": "to_dds", "type": ")" + type + R"("}]})";
+  };
+  // "p/msg/" and a type name making up the longest name the library takes.
+  const std::string longest = "p/msg/" + std::string(agnocast::type_name_max - 6, 'T');
+  EXPECT_EQ(parse_config(config_with_type(longest)).topics[0].type, longest);
+  EXPECT_EQ(error_key(config_with_type(longest + "T")), "topics[0].type");
 }
 
 TEST(Config, MissingFileIsAConfigError) {

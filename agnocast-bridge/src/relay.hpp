@@ -1,6 +1,9 @@
 // One bridged topic in one direction, for message type T.
 //   ToDds:   an agnocast subscription; each message is serialized once to
-//            XCDR1 and written with dds_writecdr.
+//            XCDR1 and written with dds_writecdr. It ignores the bridge's own
+//            publications (ignore_local_publications: the kernel never queues
+//            them for it), which are the messages FromDds relayed from DDS,
+//            so that a topic bridged both ways does not send them back.
 //   FromDds: a DDS reader; each sample's bytes are deserialized straight into
 //            a loaned agnocast message, which is then published.
 #pragma once
@@ -18,10 +21,10 @@
 #include "agnocast/cdr.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/node.hpp"
+#include "agnocast/subscription_options.hpp"
 #include "cdr_sertype.hpp"
 #include "config.hpp"
 #include "dds_domain.hpp"
-#include "own_pool.hpp"
 #include "topic_counters.hpp"
 
 namespace agnocast_bridge {
@@ -42,7 +45,6 @@ struct RelayContext {
   const TopicConfig& topic;
   agnocast::Node& node;
   DdsDomain& domain;
-  const OwnPool& own_pool;
   TopicCounters& counters;
 };
 
@@ -50,22 +52,22 @@ template <class T>
 class ToDds : public Relay {
  public:
   explicit ToDds(const RelayContext& context)
-      : own_pool_(context.own_pool),
-        counters_(context.counters),
+      : counters_(context.counters),
         dds_topic_(context.domain.create_topic(context.topic)),
         writer_(context.domain.create_writer(dds_topic_.entity.get(), context.topic.qos)) {
     agnocast::QoS qos(context.topic.qos.depth);
     if (context.topic.qos.transient_local) qos.transient_local();
+    agnocast::SubscriptionOptions options;
+    options.ignore_local_publications = true;
     subscription_ = context.node.create_subscription<T>(
         context.topic.name, qos,
-        [this](const agnocast::ipc_shared_ptr<const T>& message) { relay(*message); });
+        [this](const agnocast::ipc_shared_ptr<const T>& message) { relay(*message); }, options);
   }
 
   std::uint32_t subscription_id() const override { return subscription_->id(); }
 
  private:
   void relay(const T& message) {
-    if (own_pool_.holds(&message)) return;  // the bridge published it from DDS
     std::vector<std::uint8_t> bytes;
     try {
       bytes = agnocast::cdr::serialize(message);
@@ -84,7 +86,6 @@ class ToDds : public Relay {
     }
   }
 
-  const OwnPool& own_pool_;
   TopicCounters& counters_;
   DdsTopic dds_topic_;
   DdsEntity writer_;

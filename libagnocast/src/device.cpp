@@ -17,6 +17,7 @@
 #include "agnocast/access_policy.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/inspect.hpp"
+#include "agnocast/limits.hpp"
 
 namespace agnocast {
 
@@ -39,8 +40,19 @@ namespace {
 static_assert(AGNOCAST_VERSION_MAJOR == library_version.major &&
                   AGNOCAST_VERSION_MINOR == library_version.minor,
               "the UAPI header and the project version must agree on major.minor");
-static_assert(AGNOCAST_DEPTH_MAX == depth_max);
-static_assert(AGNOCAST_TOPIC_NAME_MAX > topic_name_max);
+// <agnocast/limits.hpp> mirrors the UAPI's limits: a change on either side
+// that the other does not follow stops the build here.
+static_assert(AGNOCAST_DEPTH_MAX == qos_depth_max && qos_depth_min == 1);
+static_assert(AGNOCAST_TOPIC_NAME_MAX > topic_name_max,
+              "the kernel must take every topic name the library allows");
+static_assert(sizeof(agnocast_add_endpoint::topic) == AGNOCAST_TOPIC_NAME_MAX);
+static_assert(AGNOCAST_NODE_NAME_MAX == node_name_max + 1);
+static_assert(sizeof(agnocast_add_endpoint::node) == AGNOCAST_NODE_NAME_MAX);
+static_assert(AGNOCAST_TYPE_NAME_MAX == type_name_max + 1);
+static_assert(sizeof(agnocast_add_endpoint::type_name) == AGNOCAST_TYPE_NAME_MAX);
+static_assert(AGNOCAST_SCHEMA_MAX == schema_max_bytes);
+static_assert(AGNOCAST_PUBLISHERS_PER_TOPIC_MAX == publishers_per_topic_max);
+static_assert(AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX == subscribers_per_topic_max);
 
 std::string errno_advice(int err) {
   switch (err) {
@@ -108,10 +120,10 @@ agnocast_add_endpoint to_uapi(const EndpointRequest& request) {
   copy_name(argument.node, sizeof argument.node, request.node, "node name");
   copy_name(argument.type_name, sizeof argument.type_name, request.type_name, "message type name");
   argument.type_hash = request.type_hash;
-  if (request.schema.size() > AGNOCAST_SCHEMA_MAX) {
+  if (request.schema.size() > schema_max_bytes) {
     throw std::invalid_argument("the schema of message type " + request.type_name + " has " +
                                 std::to_string(request.schema.size()) + " bytes: at most " +
-                                std::to_string(AGNOCAST_SCHEMA_MAX));
+                                std::to_string(schema_max_bytes));
   }
   argument.schema = reinterpret_cast<std::uintptr_t>(request.schema.data());
   argument.schema_size = static_cast<std::uint32_t>(request.schema.size());
@@ -138,7 +150,8 @@ std::string add_endpoint_advice(int err, const EndpointRequest& request, std::st
     case EINVAL:
       return "the module refused topic '" + request.topic + "', node '" + request.node +
              "', message type '" + request.type_name + "' or depth " +
-             std::to_string(request.depth) + " (1.." + std::to_string(depth_max) + ")";
+             std::to_string(request.depth) + " (" + std::to_string(qos_depth_min) + ".." +
+             std::to_string(qos_depth_max) + ")";
     default:
       return {};
   }

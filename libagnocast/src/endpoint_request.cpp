@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "agnocast/detail/endpoints.hpp"
+#include "agnocast/limits.hpp"
 #include "agnocast/naming.hpp"
 
 namespace agnocast::detail {
@@ -10,10 +11,15 @@ namespace agnocast::detail {
 EndpointRequest make_endpoint_request(std::string_view node, std::string_view topic, const QoS& qos,
                                       EndpointKind kind, const MessageType& type) {
   validate_topic_name(topic);
-  if (qos.depth() < 1 || qos.depth() > depth_max) {
-    throw std::invalid_argument("QoS depth " + std::to_string(qos.depth()) +
-                                " is out of range: it must be between 1 and " +
-                                std::to_string(depth_max));
+  if (qos.depth() < qos_depth_min || qos.depth() > qos_depth_max) {
+    throw std::invalid_argument(
+        "QoS depth " + std::to_string(qos.depth()) + " is out of range: it must be between " +
+        std::to_string(qos_depth_min) + " and " + std::to_string(qos_depth_max));
+  }
+  if (type.name.size() > type_name_max) {
+    throw std::invalid_argument("message type name '" + std::string(type.name) +
+                                "' is too long: at most " + std::to_string(type_name_max) +
+                                " characters");
   }
   EndpointRequest request;
   request.topic = std::string(topic);

@@ -10,8 +10,6 @@
 
 namespace agnocast::detail {
 
-inline constexpr std::uint32_t depth_max = 1024;
-
 struct MessageType;
 
 enum class EndpointKind { publisher, callback_subscriber, polling_subscriber };
@@ -29,7 +27,8 @@ struct EndpointRequest {
   std::span<const std::uint8_t> schema;  // kept by the kernel for tools; may be empty
 };
 
-// Validates topic and depth (std::invalid_argument naming the rule) and fills the request.
+// Validates topic, depth and type name against <agnocast/limits.hpp>
+// (std::invalid_argument naming the rule) and fills the request.
 EndpointRequest make_endpoint_request(std::string_view node, std::string_view topic, const QoS& qos,
                                       EndpointKind kind, const MessageType& type);
 

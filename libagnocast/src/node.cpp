@@ -7,12 +7,11 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "agnocast/limits.hpp"
 #include "node_state.hpp"
 
 namespace agnocast {
 namespace {
-
-constexpr std::size_t node_name_max = 127;  // the module's label size less its NUL
 
 void validate_node_name(const std::string& name) {
   if (name.size() > node_name_max) {

@@ -11,6 +11,7 @@
 
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
+#include "agnocast/limits.hpp"
 #include "endpoint_request.hpp"
 #include "log_internal.hpp"
 #include "node_state.hpp"
@@ -18,10 +19,6 @@
 #include "runtime.hpp"
 
 namespace agnocast::detail {
-
-namespace {
-constexpr std::size_t subscribers_per_topic_max = 1024;
-}
 
 struct PublisherCore::State {
   State(std::shared_ptr<NodeState> node, Runtime& runtime, const EndpointRequest& request)

@@ -4,9 +4,12 @@
 
 #include <chrono>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
+#include "agnocast/limits.hpp"
 #include "agnocast/node.hpp"
 #include "fake_runtime.hpp"
 
@@ -40,6 +43,21 @@ TEST_F(PublisherTest, GrowsItsWakeSlotsUntilEverySubscriberIsWoken) {
   }
   publish(*publisher, 2);
   EXPECT_EQ(kernel().calls().publish, 4) << "the grown wake slots are kept";
+}
+
+TEST_F(PublisherTest, DepthIsBoundedByTheLimitsHeader) {
+  Node node{"depths"};
+  EXPECT_NO_THROW(node.create_publisher<Counted>(topic("least"), QoS{qos_depth_min}));
+  EXPECT_NO_THROW(node.create_polling_subscriber<Counted>(topic("most"), QoS{qos_depth_max}));
+  for (const std::size_t depth : {qos_depth_min - 1, qos_depth_max + 1}) {
+    try {
+      node.create_publisher<Counted>(topic("beyond"), QoS{depth});
+      ADD_FAILURE() << "depth " << depth << " accepted";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find("between 1 and 1024"), std::string::npos)
+          << error.what();
+    }
+  }
 }
 
 TEST_F(PublisherTest, FreesMessagesTheKernelReportsReclaimable) {

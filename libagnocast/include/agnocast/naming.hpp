@@ -8,6 +8,8 @@
 #include <string>
 #include <string_view>
 
+#include "agnocast/limits.hpp"
+
 namespace agnocast {
 
 // The notification a publisher sends to a subscriber's queue. Its content is
@@ -19,15 +21,8 @@ struct MqMsgAgnocast {
 // Where the mqueue filesystem is mounted; a queue "/x@1" is the file "/dev/mqueue/x@1".
 inline constexpr std::string_view mqueue_directory = "/dev/mqueue";
 
-// Linux refuses queue names longer than NAME_MAX (after the leading '/').
-inline constexpr std::size_t queue_name_max = 255;
-// The longest decimal subscriber id (UINT32_MAX has 10 digits).
-inline constexpr std::size_t subscriber_id_digits_max = 10;
-// Longest topic name whose queue name fits NAME_MAX for every possible id:
-// topic (with its leading '/') - 1 + '@' + 10 digits <= 255.
-inline constexpr std::size_t topic_name_max = queue_name_max - subscriber_id_digits_max;
-
-// Empty when the name is valid, else a sentence naming the broken rule.
+// Empty when the name is valid, else a sentence naming the broken rule. Its
+// length is bounded by topic_name_max (<agnocast/limits.hpp>).
 std::string topic_name_problem(std::string_view topic);
 bool is_valid_topic_name(std::string_view topic);
 // Throws std::invalid_argument naming the rule the topic breaks.

@@ -27,14 +27,13 @@
 #include <string>
 #include <vector>
 
+#include "agnocast/limits.hpp"
 #include "agnocast/message_traits.hpp"
 
 namespace agnocast {
 
 inline constexpr std::uint32_t schema_magic = 0x43534741;  // "AGSC" in memory
 inline constexpr std::uint16_t schema_format_version = 1;
-// The kernel stores at most this much per topic.
-inline constexpr std::size_t schema_max_bytes = 4096;
 inline constexpr std::uint16_t schema_no_type = 0xFFFF;
 
 // A blob that is not a valid schema (what() says what is wrong), or a type too

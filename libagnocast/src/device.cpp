@@ -36,6 +36,7 @@ static_assert(AGNOCAST_VERSION_MAJOR == library_version.major &&
                   AGNOCAST_VERSION_MINOR == library_version.minor,
               "the UAPI header and the project version must agree on major.minor");
 static_assert(AGNOCAST_DEPTH_MAX == depth_max);
+static_assert(Kernel::receive_entries_max == AGNOCAST_RECEIVE_BATCH);
 static_assert(AGNOCAST_TOPIC_NAME_MAX > topic_name_max);
 
 std::string errno_advice(int err) {

@@ -29,7 +29,7 @@ namespace {
 class SubscriberEndpoint : public EntryOwner {
  public:
   // Releases one receive carries; a full batch is released at once.
-  static constexpr std::size_t release_batch = 32;
+  static constexpr std::size_t release_batch = Kernel::receive_entries_max;
   using ReleaseBatch = std::array<std::uint64_t, release_batch>;
 
   SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
@@ -217,13 +217,19 @@ std::size_t SubscriptionBase::handle_wakeup() {
   std::array<ReceivedEntry, Kernel::receive_entries_max> entries;
   std::array<PoolGrant, Kernel::receive_pools_max> pools;
   std::size_t delivered = 0;
-  // Take one notification, then receive until nothing is left: three system
-  // calls with the executor's wait whatever the depth, and one release at the
-  // end for what the callbacks dropped.  A publisher commits
-  // its entry before it notifies, so an entry this receive misses has a
-  // notification still to come, or one still queued (a full queue refuses
-  // one only while it holds another): either wakes us again.
-  state.queue->take_one();
+  // Receive until nothing is left, run the callbacks, then take the one
+  // notification that woke us: three system calls with the executor's wait
+  // whatever the depth, and one release at the end for what the callbacks
+  // dropped.  A publisher commits its entry before it notifies, and the
+  // notification taken was queued before the receive (the executor runs a
+  // wake-up on one thread at a time), so its entry was received.  An entry
+  // this receive missed has a notification still to come, or one still
+  // queued (a queue refuses one only while full, and it holds two at least):
+  // either wakes us again.  A queue that holds one only (fs.mqueue.msg_max
+  // 1) is drained first instead.  A throwing callback leaves the
+  // notification queued, for the entries it did not reach.
+  const bool drain_after = state.queue->drains_after();
+  if (!drain_after) state.queue->take_one();
   SubscriberEndpoint::ReleaseBatch releases;
   SubscriberEndpoint& endpoint = *state.endpoint;
   endpoint.begin_wakeup();
@@ -260,6 +266,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
     }
     if (result.remaining == 0) break;
   }
+  if (drain_after) state.queue->take_one();
   return delivered;
 }
 

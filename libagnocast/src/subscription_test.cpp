@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "agnocast/executor.hpp"
 #include "agnocast/node.hpp"
 #include "fake_runtime.hpp"
 
@@ -73,10 +74,20 @@ long queued(int queue_fd) {
   return attributes.mq_curmsgs;
 }
 
+// Waits until the deferred release's timer expires, then runs it as the
+// executor would.
+bool run_deferred_release(SubscriptionBase& subscription) {
+  pollfd entry{subscription.release_timer_fd(), POLLIN, 0};
+  if (::poll(&entry, 1, 2000) != 1) return false;
+  subscription.release_deferred();
+  return true;
+}
+
 // The subscriber's system calls per message in its steady state, one message
-// per wake-up: besides the executor's wait, one notification taken and the
-// kernel calls the fake kernel counts (RECEIVE, and RELEASE for the message
-// the callback dropped), at depth 1 and 10.
+// per wake-up: besides the executor's wait, one notification taken and one
+// RECEIVE (the fake kernel counts every call), which carries the release of
+// the message before; at depth 1 and 10.  The last message's release waits
+// for the deferred release.
 TEST_F(SubscriptionTest, SteadyStateSystemCallsPerMessageAtDepthOneAndTen) {
   for (const std::uint32_t depth : {1U, 10U}) {
     Node node{"calls"};
@@ -104,9 +115,12 @@ TEST_F(SubscriptionTest, SteadyStateSystemCallsPerMessageAtDepthOneAndTen) {
         (after.receive - before.receive) + (after.release - before.release) +
         (after.take - before.take) + (after.reclaim - before.reclaim) + (after.shed - before.shed);
     EXPECT_EQ(after.receive - before.receive, messages) << "depth " << depth;
-    EXPECT_EQ(subscriber_kernel_calls, 2 * messages) << "depth " << depth;
+    EXPECT_EQ(subscriber_kernel_calls, messages) << "depth " << depth;
     EXPECT_EQ(notifications_taken, messages) << "depth " << depth;
-    EXPECT_EQ(after.released_entries - before.released_entries, messages) << "depth " << depth;
+    EXPECT_EQ(after.released_entries - before.released_entries, messages - 1) << "depth " << depth;
+    ASSERT_TRUE(run_deferred_release(*subscription));
+    EXPECT_EQ(kernel().calls().release - after.release, 1) << "depth " << depth;
+    EXPECT_EQ(kernel().calls().released_entries - before.released_entries, messages);
   }
 }
 
@@ -152,15 +166,93 @@ TEST_F(SubscriptionTest, MessagesDroppedInOneWakeUpGoBackInOneRelease) {
   const FakeKernel::Calls before = kernel().calls();
 
   for (std::uint64_t seq = 1; seq <= 3; ++seq) publish(*publisher, seq);
+  const auto start = std::chrono::steady_clock::now();
   subscription->handle_wakeup();
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 3U) << "they wait for the next receive";
+  EXPECT_EQ(kernel().calls().release, before.release);
+  // Nothing else arrives: the deferred release gives them back, within the bound.
+  ASSERT_TRUE(run_deferred_release(*subscription));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(500));
   const FakeKernel::Calls after = kernel().calls();
   EXPECT_EQ(seen, (std::vector<std::uint64_t>{1, 2, 3}));
   EXPECT_EQ(after.receive - before.receive, 1);
   EXPECT_EQ(after.release - before.release, 1);
   EXPECT_EQ(after.released_entries - before.released_entries, 3);
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 0U) << "nothing stays held after the deferred release";
+}
+
+TEST_F(SubscriptionTest, MessagesDroppedInOneWakeUpRideOnTheNextReceive) {
+  Node node{"riding"};
+  const std::string name = topic("riding");
+  int count = 0;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>&) { ++count; });
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  subscription->handle_wakeup();
+  for (std::uint64_t seq = 1; seq <= 3; ++seq) publish(*publisher, seq);
+  subscription->handle_wakeup();
+  const FakeKernel::Calls before = kernel().calls();
+  publish(*publisher, 4);
+  subscription->handle_wakeup();
+  const FakeKernel::Calls after = kernel().calls();
+  EXPECT_EQ(count, 4);
+  EXPECT_EQ(after.receive - before.receive, 1);
+  EXPECT_EQ(after.release - before.release, 0);
+  EXPECT_EQ(after.released_entries - before.released_entries, 3);
   TopicInfo info;
   ASSERT_TRUE(kernel().topic_info(name, info));
-  EXPECT_EQ(info.subscribers.at(0).held, 0U) << "nothing stays held after the wake-up";
+  EXPECT_EQ(info.subscribers.at(0).held, 1U);
+  // The timer armed after the first wake-up still bounds the last one's wait.
+  ASSERT_TRUE(run_deferred_release(*subscription));
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 0U);
+  EXPECT_EQ(kernel().calls().release - after.release, 1);
+}
+
+// A callback that throws: what its wake-up received goes back at once.
+TEST_F(SubscriptionTest, AThrowingCallbacksWakeUpReleasesAtOnce) {
+  Node node{"throwing"};
+  const std::string name = topic("throwing");
+  auto subscription =
+      node.create_subscription<Counted>(name, QoS{10}, [&](const ipc_shared_ptr<const Counted>& m) {
+        if (m->seq == 2) throw std::runtime_error("callback failed");
+      });
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  subscription->handle_wakeup();
+  publish(*publisher, 1);
+  publish(*publisher, 2);
+  const FakeKernel::Calls before = kernel().calls();
+  EXPECT_THROW(subscription->handle_wakeup(), std::runtime_error);
+  EXPECT_EQ(kernel().calls().release - before.release, 1);
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 0U);
+}
+
+// Driven by an executor: the deferred release runs in spin_once() without
+// counting as handled work, and without anything else arriving.
+TEST_F(SubscriptionTest, AnExecutorRunsTheDeferredReleaseAsHousekeeping) {
+  Node node{"housekeeping"};
+  const std::string name = topic("housekeeping");
+  int count = 0;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{1}, [&](const ipc_shared_ptr<const Counted>&) { ++count; });
+  auto publisher = node.create_publisher<Counted>(name, QoS{1});
+  SingleThreadedExecutor executor;
+  executor.add_node(node);
+  ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(100)));  // its own notification
+  publish(*publisher, 1);
+  ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(1000)));
+  EXPECT_EQ(count, 1);
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 1U);
+  EXPECT_FALSE(executor.spin_once(std::chrono::milliseconds(200)));
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 0U);
 }
 
 TEST_F(SubscriptionTest, ASingleNotificationCostsOneReceive) {

@@ -230,7 +230,8 @@ std::optional<SyscallCounter> open_counter() {
 }
 
 struct Window {
-  std::optional<SyscallCounter> counter = open_counter();
+  explicit Window(bool count_syscalls) : counter(count_syscalls ? open_counter() : std::nullopt) {}
+  std::optional<SyscallCounter> counter;
   SyscallCounts start_counts;
   std::int64_t start_cpu = 0;
   std::uint64_t start_allocations = 0;
@@ -265,7 +266,8 @@ std::optional<SyscallCounts> counts_per_message(const std::vector<std::int64_t>&
 
 }  // namespace
 
-SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers) {
+SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers,
+                                 bool count_syscalls) {
   const std::string topic = next_topic("steady");
   const std::size_t total = steady_warmup_messages + count + 1;
   Pipe ready = Pipe::open(), publisher_report = Pipe::open();
@@ -277,7 +279,7 @@ SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size
     subscriber_pids.push_back(spawn([&, report_fd] {
       agnocast::SingleThreadedExecutor executor;
       agnocast::Node node{"bench_subscriber"};
-      Window window;
+      Window window(count_syscalls);
       std::size_t in_window = 0;
       bool counting = false;
       // The callback makes no system call of its own between the two
@@ -309,7 +311,7 @@ SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size
     agnocast::Node node{"bench_publisher"};
     auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{depth});
     read_bytes(ready.read_fd, subscribers);
-    Window window;
+    Window window(count_syscalls);
     std::int64_t next = now_ns();
     for (std::size_t seq = 0; seq < total; ++seq) {
       next += steady_period_ns;

@@ -34,18 +34,23 @@ struct Throughput {
 Throughput run_agnocast_throughput(std::size_t size, std::size_t count);
 
 // One message a millisecond from one publisher to `subscribers`, both sides
-// with QoS depth `depth`: CPU time and counted system calls of each side over
-// `count` messages (the first subscriber's), in steady state.  The counts
-// are over "messages" messages (a QoS 1 subscriber may lose some).
+// with QoS depth `depth`: CPU time and heap allocations of each side over
+// `count` messages (the first subscriber's), in steady state, and with
+// `count_syscalls` the system calls too.  The counters cost each counted
+// call thousands of instructions, so CPU time is only fair (comparable with
+// iceoryx's and the floor's, taken without counters) from a run without
+// them.  The counts are over "messages" messages (a QoS 1 subscriber may
+// lose some).
 struct SteadyResult {
   CpuPerMessage cpu;
-  std::optional<SyscallCounts> publisher;  // empty when the kernel has no counters
+  std::optional<SyscallCounts> publisher;  // empty when not counted or no counters
   std::optional<SyscallCounts> subscriber;
   // Heap allocations (operator new) per message on each side's thread.
   double publisher_allocations = 0;
   double subscriber_allocations = 0;
 };
-SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers);
+SteadyResult run_agnocast_steady(std::size_t depth, std::size_t count, std::size_t subscribers,
+                                 bool count_syscalls);
 
 // `topics` other topics, each carrying one 64 B message every `period_ns`
 // from one publisher process to one subscriber process, while it lives.

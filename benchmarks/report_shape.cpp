@@ -44,10 +44,15 @@ class Checker {
     }
   }
 
-  void ratio(const std::string& name) {
+  // In icount mode a ratio is one value, without interval.
+  void ratio(const std::string& name, bool single) {
     const json* value = at({"ratios", name});
-    const json* interval = at({"ratio_ci", name});
     at({"targets", name});
+    if (single) {
+      if (value && !positive_number(*value)) errors.push_back("ratio " + name + " not positive");
+      return;
+    }
+    const json* interval = at({"ratio_ci", name});
     if (!value || !interval) return;
     if (!positive_number(*value) || !interval->is_array() || interval->size() != 2 ||
         !positive_number((*interval)[0]) || !positive_number((*interval)[1]) ||
@@ -79,13 +84,18 @@ class Checker {
   const json& report_;
 };
 
+// Latencies print in µs; in icount mode in ns, which are instructions there.
+double unit_per_us = 1;
+const char* unit = "µs";
+
 std::string cell(const json& latency, const std::string& who, const std::string& label) {
   if (!latency.contains(who) || latency[who].is_null() || !latency[who].contains(label)) {
     return "—";
   }
   char text[64];
-  std::snprintf(text, sizeof text, "%.0f / %.0f", latency[who][label]["p50_us"].get<double>(),
-                latency[who][label]["p99_us"].get<double>());
+  std::snprintf(text, sizeof text, "%.0f / %.0f",
+                latency[who][label]["p50_us"].get<double>() * unit_per_us,
+                latency[who][label]["p99_us"].get<double>() * unit_per_us);
   return text;
 }
 
@@ -109,11 +119,14 @@ std::string by_call(const json& calls) {
 
 std::vector<std::string> report_shape_errors(const json& report) {
   Checker check(report);
+  const json* mode = check.at({"mode"});
+  if (mode && *mode != "icount" && *mode != "ordinary") check.errors.push_back("unknown mode");
+  const bool icount = mode && *mode == "icount";
   for (const char* key : {"kernel", "cpu", "system", "clocksource"}) check.at({"machine", key});
   check.positive({"machine", "cpus"});
   const json* rounds = check.at({"rounds"});
   if (rounds && (!rounds->is_number_unsigned() || rounds->get<std::size_t>() < 2 ||
-                 (!report["smoke"].get<bool>() && rounds->get<std::size_t>() < 20))) {
+                 (!report["smoke"].get<bool>() && !icount && rounds->get<std::size_t>() < 20))) {
     check.errors.push_back("too few rounds for the intervals");
   }
   const json* failed = check.at({"failed_cells"});
@@ -125,7 +138,7 @@ std::vector<std::string> report_shape_errors(const json& report) {
   for (const char* who : {"agnocast", "iceoryx"}) {
     for (const char* size : {"64 B", "4 KiB"}) check.latency(who, size);
   }
-  check.latency("agnocast_beside_63_busy_topics", "64 B");
+  if (!icount) check.latency("agnocast_beside_63_busy_topics", "64 B");
   for (const char* who :
        {"agnocast_constant_bytes", "iceoryx_constant_bytes", "unix_socket_constant_bytes"}) {
     for (const char* size : {"64 B", "4 KiB", "1 MiB", "16 MiB", "64 MiB"}) {
@@ -137,13 +150,17 @@ std::vector<std::string> report_shape_errors(const json& report) {
   }
   // The slope's difference of p50s may be negative in a tiny smoke run, so
   // fanout_slope is only required to be there.
-  for (const char* name : {"size_flatness", "size_flatness_iceoryx", "vs_iceoryx",
-                           "vs_mqueue_floor", "vs_epoll_floor", "topics_64", "fanout_64"}) {
-    check.ratio(name);
+  for (const char* name : {"size_flatness", "size_flatness_iceoryx", "vs_iceoryx", "vs_iceoryx_64",
+                           "vs_mqueue_floor", "vs_epoll_floor", "fanout_64"}) {
+    check.ratio(name, icount);
   }
   check.at({"ratios", "fanout_slope"});
-  check.at({"ratio_ci", "fanout_slope"});
-  check.positive({"background", "delivered_per_s"});
+  if (!icount) {
+    check.ratio("topics_64", false);
+    check.ratio("vs_iceoryx_constant_bytes", false);
+    check.at({"ratio_ci", "fanout_slope"});
+    check.positive({"background", "delivered_per_s"});
+  }
   // The seed's protocol: the publisher enters the kernel and wakes each
   // subscriber; the subscriber waits, then enters the kernel.
   for (const char* run : {"qos_10", "qos_1"}) {
@@ -167,15 +184,19 @@ std::vector<std::string> report_shape_errors(const json& report) {
 
 void print_markdown(const json& report) {
   const json& machine = report["machine"];
+  const bool icount = report.value("mode", "ordinary") == "icount";
   std::printf(
-      "Run: kernel %s, %s (%s), %lld CPUs, %lld MiB, clocksource %s; %zu rounds%s.\n\n",
-      machine["kernel"].get<std::string>().c_str(), machine["system"].get<std::string>().c_str(),
-      machine["cpu"].get<std::string>().c_str(), machine["cpus"].get<long long>(),
-      machine["memory_mib"].get<long long>(), machine["clocksource"].get<std::string>().c_str(),
-      report["rounds"].get<std::size_t>(), report["smoke"].get<bool>() ? " (smoke)" : "");
+      "Run (%s mode): kernel %s, %s (%s), %lld CPUs, %lld MiB, clocksource %s; %zu rounds%s.\n\n",
+      icount ? "icount" : "ordinary", machine["kernel"].get<std::string>().c_str(),
+      machine["system"].get<std::string>().c_str(), machine["cpu"].get<std::string>().c_str(),
+      machine["cpus"].get<long long>(), machine["memory_mib"].get<long long>(),
+      machine["clocksource"].get<std::string>().c_str(), report["rounds"].get<std::size_t>(),
+      report["smoke"].get<bool>() ? " (smoke)" : "");
+  unit_per_us = icount ? 1000 : 1;
+  unit = icount ? "ns (instructions)" : "µs";
   const json& latency = report["latency"];
 
-  std::printf("| one-way latency, µs (p50 / p99) | 64 B | 4 KiB |\n|---|---|---|\n");
+  std::printf("| one-way latency, %s (p50 / p99) | 64 B | 4 KiB |\n|---|---|---|\n", unit);
   const std::pair<const char*, const char*> plain[] = {
       {"agnocast", "agnocast"},
       {"iceoryx", "iceoryx"},
@@ -191,8 +212,9 @@ void print_markdown(const json& report) {
               cell(latency, "mqueue_epoll_floor", "1 B").c_str());
 
   std::printf(
-      "| one-way latency, µs (p50 / p99), 64 MiB written before each sample | agnocast | "
-      "iceoryx | Unix socket (copy) |\n|---|---|---|---|\n");
+      "| one-way latency, %s (p50 / p99), 64 MiB written before each sample | agnocast | "
+      "iceoryx | Unix socket (copy) |\n|---|---|---|---|\n",
+      unit);
   if (latency.contains("agnocast_constant_bytes")) {
     for (const auto& [label, stats] : latency["agnocast_constant_bytes"].items()) {
       std::printf("| %s | %s | %s | %s |\n", label.c_str(),
@@ -203,8 +225,9 @@ void print_markdown(const json& report) {
   }
 
   std::printf(
-      "\n| publish to last delivery, µs (p50 / p99) | agnocast, 4 KiB | mqueue wake-ups, "
-      "receivers in `epoll_wait` |\n|---|---|---|\n");
+      "\n| publish to last delivery, %s (p50 / p99) | agnocast, 4 KiB | mqueue wake-ups, "
+      "receivers in `epoll_wait` |\n|---|---|---|\n",
+      unit);
   if (latency.contains("agnocast_fanout")) {
     for (const auto& [label, stats] : latency["agnocast_fanout"].items()) {
       std::printf("| %s subscriber(s) | %s | %s |\n", label.c_str(),
@@ -213,17 +236,26 @@ void print_markdown(const json& report) {
     }
   }
 
-  std::printf(
-      "\n| ratio (lower is better) | median of rounds | 95 %% interval | target | met |\n"
-      "|---|---|---|---|---|\n");
+  if (icount) {
+    std::printf("\n| ratio (lower is better) | value | target | met |\n|---|---|---|---|\n");
+  } else {
+    std::printf(
+        "\n| ratio (lower is better) | median of rounds | 95 %% interval | target | met |\n"
+        "|---|---|---|---|---|\n");
+  }
   for (const auto& [name, value] : report["ratios"].items()) {
+    const json& met = report["met"][name];
+    const char* met_text = met.is_boolean() ? (met.get<bool>() ? "yes" : "no") : "—";
+    if (icount) {
+      std::printf("| `%s` | %s | ≤ %s | %s |\n", name.c_str(), number(value, "%.3f").c_str(),
+                  number(report["targets"][name], "%g").c_str(), met_text);
+      continue;
+    }
     const json& interval = report["ratio_ci"][name];
     const std::string range =
         interval.is_array() ? number(interval[0]) + "–" + number(interval[1]) : std::string("—");
-    const json& met = report["met"][name];
     std::printf("| `%s` | %s | %s | ≤ %s | %s |\n", name.c_str(), number(value).c_str(),
-                range.c_str(), number(report["targets"][name], "%g").c_str(),
-                met.is_boolean() ? (met.get<bool>() ? "yes" : "no") : "—");
+                range.c_str(), number(report["targets"][name], "%g").c_str(), met_text);
   }
 
   std::printf(
@@ -265,10 +297,12 @@ void print_markdown(const json& report) {
   const json& slopes = report["fanout_slope_us_per_subscriber"];
   std::printf("\nFan-out slope, µs per extra subscriber: agnocast %s, mqueue wake-ups %s.\n",
               number(slopes["agnocast"], "%.1f").c_str(), number(slopes["mqueue"], "%.1f").c_str());
-  const json& background = report["background"];
-  std::printf("Beside 63 busy topics: %s of %s messages/s offered were delivered.\n",
-              number(background["delivered_per_s"], "%.0f").c_str(),
-              number(background["offered_per_s"], "%.0f").c_str());
+  if (report.contains("background")) {
+    const json& background = report["background"];
+    std::printf("Beside 63 busy topics: %s of %s messages/s offered were delivered.\n",
+                number(background["delivered_per_s"], "%.0f").c_str(),
+                number(background["offered_per_s"], "%.0f").c_str());
+  }
   std::printf("Throughput, 64 B back to back: %s messages/s (%llu of %llu received).\n",
               number(report["throughput"]["messages_per_s"], "%.0f").c_str(),
               report["throughput"]["received"].get<unsigned long long>(),

@@ -9,7 +9,9 @@
  * reuse; otherwise it is freed and may free its pool.
  *
  * A subscriber keeps its unreceived entries in a ring of its depth (a full
- * ring drops its oldest) and its held ones in an xarray by entry id.
+ * ring drops its oldest) and its held ones in an array ordered by entry id,
+ * which grows when needed and never shrinks, so receiving and releasing
+ * allocate nothing in a subscriber's steady state.
  *
  * This file never touches user memory and never calls back into topics or
  * ioctls.  Everything about a topic's entries runs under the topic's lock
@@ -183,61 +185,53 @@ void agnocast_sub_fill_transient(struct agnocast_subscriber *sub)
 /* Drops every unreceived and held reference of @sub. */
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub)
 {
-	struct agnocast_topic_entry *entry;
-	unsigned long id;
+	u32 i;
 
 	while (sub->nr_unreceived)
 		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
-	xa_for_each(&sub->held, id, entry)
-		agnocast_entry_unref(entry);
-	xa_destroy(&sub->held);
+	for (i = 0; i < sub->nr_held; i++)
+		agnocast_entry_unref(sub->held[i]);
 	sub->nr_held = 0;
 }
 
 /*
- * Reserves the held slots of the @n oldest unreceived entries (RECEIVE) or,
- * with @newest, of the newest one (TAKE, @n 1), so that holding them cannot
- * fail.
+ * Makes room for @n more held entries, so that holding them cannot fail.
+ * The array only grows (it starts at twice the depth), so a subscriber in
+ * its steady state allocates nothing here.
  */
-int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n, bool newest)
+int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n)
 {
-	u32 first = newest ? sub->nr_unreceived - n : 0;
-	u32 i;
-	int ret;
+	struct agnocast_topic_entry **held;
+	u32 capacity;
 
 	lockdep_assert_held(&sub->ep.topic->lock);
-	for (i = 0; i < n; i++) {
-		ret = xa_reserve(&sub->held, agnocast_sub_unreceived(sub, first + i)->id,
-				 GFP_KERNEL_ACCOUNT);
-		if (ret) {
-			while (i--)
-				xa_release(&sub->held, agnocast_sub_unreceived(sub, first + i)->id);
-			return ret;
-		}
-	}
+	if (n <= sub->held_capacity - sub->nr_held)
+		return 0;
+	capacity = max(sub->nr_held + n, 2 * sub->held_capacity);
+	held = kvmalloc_array(capacity, sizeof(*held), GFP_KERNEL_ACCOUNT);
+	if (!held)
+		return -ENOMEM;
+	memcpy(held, sub->held, sub->nr_held * sizeof(*held));
+	kvfree(sub->held);
+	sub->held = held;
+	sub->held_capacity = capacity;
 	return 0;
 }
 
-/* Undoes agnocast_sub_reserve_held(). */
-void agnocast_sub_unreserve_held(struct agnocast_subscriber *sub, u32 n, bool newest)
-{
-	u32 first = newest ? sub->nr_unreceived - n : 0;
-	u32 i;
-
-	for (i = 0; i < n; i++)
-		xa_release(&sub->held, agnocast_sub_unreceived(sub, first + i)->id);
-}
-
-/* Stores into a reserved slot: no allocation, cannot fail. */
+/*
+ * Stores into reserved room.  Entries are held in the order of their ids:
+ * a subscriber receives its entries oldest first, and TAKE passes over the
+ * older ones, so the newest held is always the one just taken.
+ */
 static void agnocast_sub_hold(struct agnocast_subscriber *sub,
 			      struct agnocast_topic_entry *entry)
 {
-	xa_store(&sub->held, entry->id, entry, GFP_NOWAIT);
-	sub->nr_held++;
+	WARN_ON_ONCE(sub->nr_held && sub->held[sub->nr_held - 1]->id >= entry->id);
+	sub->held[sub->nr_held++] = entry;
 	sub->received++;
 }
 
-/* RECEIVE: the oldest unreceived entry becomes held (its slot reserved). */
+/* RECEIVE: the oldest unreceived entry becomes held (its room reserved). */
 void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub)
 {
 	agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
@@ -251,32 +245,77 @@ void agnocast_sub_take_newest(struct agnocast_subscriber *sub)
 	agnocast_sub_hold_oldest(sub);
 }
 
+/* While a release is checked, bit 0 of a held pointer flags it listed. */
+#define AGNOCAST_HELD_LISTED 1UL
+
+static bool agnocast_held_listed(const struct agnocast_topic_entry *entry)
+{
+	return (unsigned long)entry & AGNOCAST_HELD_LISTED;
+}
+
+static struct agnocast_topic_entry *agnocast_held_flip(struct agnocast_topic_entry *entry)
+{
+	return (struct agnocast_topic_entry *)((unsigned long)entry ^ AGNOCAST_HELD_LISTED);
+}
+
+/* The index of held entry @id (binary search, listed or not), or -1. */
+static int agnocast_sub_find_held(const struct agnocast_subscriber *sub, u64 id)
+{
+	u32 lo = 0, hi = sub->nr_held;
+
+	while (lo < hi) {
+		u32 mid = lo + (hi - lo) / 2;
+		const struct agnocast_topic_entry *entry = sub->held[mid];
+		u64 mid_id;
+
+		if (agnocast_held_listed(entry))
+			entry = agnocast_held_flip((struct agnocast_topic_entry *)entry);
+		mid_id = entry->id;
+		if (mid_id == id)
+			return mid;
+		if (mid_id < id)
+			lo = mid + 1;
+		else
+			hi = mid;
+	}
+	return -1;
+}
+
 /*
  * Drops @sub's references to the @n entries @ids, all or none (-ENOENT when
- * one is not held, or listed twice).  Held entries are found by id in an
- * xarray; a mark flags those already listed.
+ * one is not held, or listed twice).  Held entries are found by binary
+ * search; the array is then compacted from the first one released.
  */
 int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n)
 {
-	struct agnocast_topic_entry *entry;
-	u32 i;
+	u32 i, r, w, first = U32_MAX;
+	int k;
 
 	lockdep_assert_held(&sub->ep.topic->lock);
 	for (i = 0; i < n; i++) {
-		if (!xa_load(&sub->held, ids[i]) || xa_get_mark(&sub->held, ids[i], XA_MARK_0))
+		k = agnocast_sub_find_held(sub, ids[i]);
+		if (k < 0 || agnocast_held_listed(sub->held[k]))
 			break;
-		xa_set_mark(&sub->held, ids[i], XA_MARK_0);
+		sub->held[k] = agnocast_held_flip(sub->held[k]);
+		first = min_t(u32, first, k);
 	}
 	if (i < n) {
-		while (i--)
-			xa_clear_mark(&sub->held, ids[i], XA_MARK_0);
+		while (i--) {
+			k = agnocast_sub_find_held(sub, ids[i]);
+			sub->held[k] = agnocast_held_flip(sub->held[k]);
+		}
 		return -ENOENT;
 	}
-	for (i = 0; i < n; i++) {
-		entry = xa_erase(&sub->held, ids[i]);
-		sub->nr_held--;
-		agnocast_entry_unref(entry);
+	if (!n)
+		return 0;
+	for (r = w = first; r < sub->nr_held; r++) {
+		if (agnocast_held_listed(sub->held[r])) {
+			agnocast_entry_unref(agnocast_held_flip(sub->held[r]));
+			continue;
+		}
+		sub->held[w++] = sub->held[r];
 	}
+	sub->nr_held = w;
 	return 0;
 }
 

@@ -209,8 +209,10 @@ struct agnocast_subscriber {
 	struct agnocast_topic_entry **unreceived;
 	u32 head;
 	u32 nr_unreceived;
-	struct xarray held;		/* entry id -> struct agnocast_topic_entry */
+	/* Held entries, by id; room for @held_capacity. */
+	struct agnocast_topic_entry **held;
 	u32 nr_held;
+	u32 held_capacity;
 	u64 received;
 	u64 dropped;
 	/* Callback subscribers: queued when the process dies (ns->lock). */
@@ -331,8 +333,7 @@ struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subsc
 						     u32 i);
 void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
-int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n, bool newest);
-void agnocast_sub_unreserve_held(struct agnocast_subscriber *sub, u32 n, bool newest);
+int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n);
 void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub);
 void agnocast_sub_take_newest(struct agnocast_subscriber *sub);
 int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n);

@@ -17,12 +17,12 @@
 
 #include "agnocast_internal.h"
 
-/* Entries a RECEIVE handles without allocating; 4 keeps the frame small. */
-#define AGNOCAST_RECEIVE_SMALL 4
+/* Entries a RECEIVE handles without allocating (the UAPI's batch). */
+#define AGNOCAST_RECEIVE_SMALL AGNOCAST_RECEIVE_BATCH
 /* Subscribers a PUBLISH wakes without allocating. */
 #define AGNOCAST_WAKE_SMALL 16
 /* Entry ids a RELEASE or RECEIVE releases without allocating. */
-#define AGNOCAST_RELEASE_SMALL 8
+#define AGNOCAST_RELEASE_SMALL AGNOCAST_RECEIVE_BATCH
 
 static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 				 bool publisher)
@@ -156,10 +156,25 @@ int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
 static int agnocast_out_writable(u64 ubuf, size_t bytes)
 {
 	char __user *p = u64_to_user_ptr(ubuf);
+	char __user *end = p + bytes;
+	char c;
 
 	if (!bytes)
 		return 0;
-	return access_ok(p, bytes) && !fault_in_safe_writeable(p, bytes) ? 0 : -EFAULT;
+	if (!access_ok(p, bytes))
+		return -EFAULT;
+	/*
+	 * One byte of each page, written back with its own value: the page is
+	 * writable and present, and what the caller keeps there is unchanged.
+	 * Cheaper than fault_in_safe_writeable(), which walks the page tables
+	 * through get_user_pages for every call.
+	 */
+	while (p < end) {
+		if (get_user(c, p) || put_user(c, p))
+			return -EFAULT;
+		p = (char __user *)PAGE_ALIGN((unsigned long)p + 1);
+	}
+	return 0;
 }
 
 /* Writes an answer after commit; a failure loses only the answer (see above). */
@@ -558,14 +573,12 @@ relock:
 		installed = grants.count;
 		goto relock;
 	}
-	ret = agnocast_sub_reserve_held(sub, n, false);
+	ret = agnocast_sub_reserve_held(sub, n);
 	if (ret)
 		goto out_unlock;
 	ret = agnocast_sub_release(sub, release_ids, arg.release_count);
-	if (ret) {
-		agnocast_sub_unreserve_held(sub, n, false);
+	if (ret)
 		goto out_unlock;
-	}
 
 	/* Commit: nothing below fails. */
 	for (i = 0; i < n; i++)
@@ -655,7 +668,7 @@ relock:
 				goto out_put;
 			goto relock;
 		}
-		ret = agnocast_sub_reserve_held(sub, 1, true);
+		ret = agnocast_sub_reserve_held(sub, 1);
 		if (ret)
 			goto out_unlock;
 		/* Commit: older unreceived entries are passed over, not dropped. */

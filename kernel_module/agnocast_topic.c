@@ -278,6 +278,7 @@ static void agnocast_endpoint_free(struct agnocast_endpoint *ep)
 	sub = agnocast_to_subscriber(ep);
 	agnocast_exit_record_free(sub->exit_record);
 	kvfree(sub->unreceived);
+	kvfree(sub->held);
 	kfree(sub);
 }
 
@@ -306,11 +307,16 @@ struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
 		sub = kzalloc(sizeof(*sub), GFP_KERNEL_ACCOUNT);
 		if (!sub)
 			return NULL;
-		xa_init(&sub->held);
 		ep = &sub->ep;
 		sub->unreceived = kvmalloc_array(arg->depth, sizeof(*sub->unreceived),
 						 GFP_KERNEL_ACCOUNT);
 		if (!sub->unreceived)
+			goto err_free;
+		/* A wake-up's entries, and those of the one before, still held. */
+		sub->held_capacity = 2 * arg->depth;
+		sub->held = kvmalloc_array(sub->held_capacity, sizeof(*sub->held),
+					   GFP_KERNEL_ACCOUNT);
+		if (!sub->held)
 			goto err_free;
 		if (!(arg->flags & AGNOCAST_POLLING)) {
 			sub->exit_record = agnocast_exit_record_alloc();

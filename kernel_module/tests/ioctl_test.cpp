@@ -1209,6 +1209,105 @@ TEST_F(Device, ReceiveReleasesTheListedEntriesFirst) {
   EXPECT_EQ(unreceived_held(dev, "/rr"), std::make_pair(0u, 1u));
 }
 
+// Held entries outgrow the room a subscriber starts with (twice its depth)
+// and are found again by id, released in any order and in any grouping.
+TEST_F(Device, HeldEntriesOutgrowTheirRoomAndReleaseInAnyOrder) {
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/hg", 1, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/hg", 1, &sub), 0);
+  std::vector<uint64_t> ids;
+  for (int i = 0; i < 100; i++) {
+    ASSERT_EQ(publish(dev, pub, reg.addr + 64 * i), 0);
+    ReceiveResult rr;
+    ASSERT_EQ(receive(dev, sub, &rr), 0);
+    ASSERT_EQ(rr.entries.size(), 1u);
+    ASSERT_EQ(rr.entries[0].addr, reg.addr + 64 * i);
+    ids.push_back(rr.entries[0].entry_id);
+  }
+  EXPECT_EQ(unreceived_held(dev, "/hg"), std::make_pair(0u, 100u));
+
+  // A duplicate or a stranger anywhere in the list: nothing released.
+  EXPECT_EQ(release_list(dev, sub, {ids[99], ids[0], ids[50], ids[0]}), -ENOENT);
+  EXPECT_EQ(release_list(dev, sub, {ids[10], ids[99] + 1}), -ENOENT);
+  EXPECT_EQ(unreceived_held(dev, "/hg"), std::make_pair(0u, 100u));
+
+  // Every third, newest first.
+  std::vector<uint64_t> thirds;
+  for (int i = 99; i >= 0; i -= 3) thirds.push_back(ids[i]);
+  ASSERT_LE(thirds.size(), size_t{AGNOCAST_RELEASE_MAX});
+  EXPECT_EQ(release_list(dev, sub, thirds), 0);
+  const uint32_t left = 100 - static_cast<uint32_t>(thirds.size());
+  EXPECT_EQ(unreceived_held(dev, "/hg"), std::make_pair(0u, left));
+  for (uint64_t id : thirds) EXPECT_EQ(release(dev, sub, id), -ENOENT) << id;
+
+  // The rest one by one, from the middle outwards; each exactly once.
+  std::vector<uint64_t> rest;
+  for (int i = 0; i < 100; i++) {
+    if ((99 - i) % 3) rest.push_back(ids[i]);
+  }
+  ASSERT_EQ(rest.size(), left);
+  size_t lo = rest.size() / 2, hi = lo + 1;
+  while (lo > 0 || hi <= rest.size()) {
+    if (lo > 0) {
+      --lo;
+      EXPECT_EQ(release(dev, sub, rest[lo]), 0) << rest[lo];
+      EXPECT_EQ(release(dev, sub, rest[lo]), -ENOENT) << rest[lo];
+    }
+    if (hi <= rest.size()) {
+      EXPECT_EQ(release(dev, sub, rest[hi - 1]), 0) << rest[hi - 1];
+      ++hi;
+    }
+  }
+  EXPECT_EQ(unreceived_held(dev, "/hg"), std::make_pair(0u, 0u));
+
+  // Held again after all that: the room is reused.
+  ASSERT_EQ(publish(dev, pub, reg.addr), 0);
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, sub, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  EXPECT_EQ(unreceived_held(dev, "/hg"), std::make_pair(0u, 1u));
+  EXPECT_EQ(release(dev, sub, rr.entries[0].entry_id), 0);
+}
+
+// Outputs are probed one byte per page: a buffer whose last page is
+// read-only fails with -EFAULT before anything is received.
+TEST_F(Device, ReceiveIntoABufferEndingReadOnlyReceivesNothing) {
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/ro", 4, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/ro", 4, &sub), 0);
+  ASSERT_EQ(publish(dev, pub, reg.addr), 0);
+  const long page = sysconf(_SC_PAGESIZE);
+  auto* area = static_cast<char*>(
+      mmap(nullptr, 2 * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
+  ASSERT_NE(area, MAP_FAILED);
+  // The first entry fits in the writable page; the buffer's end does not.
+  const size_t capacity = 4;
+  char* entries = area + page - sizeof(agnocast_entry);
+  std::memset(entries, 0x5a, sizeof(agnocast_entry));
+  ASSERT_EQ(mprotect(area + page, page, PROT_READ), 0);
+  agnocast_pool pools[2];
+  agnocast_receive arg{};
+  arg.topic_handle = sub.handle;
+  arg.subscriber_id = sub.id;
+  arg.entries = uptr(entries);
+  arg.entry_capacity = capacity;
+  arg.pools = uptr(pools);
+  arg.pool_capacity = 2;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, &arg), -EFAULT);
+  EXPECT_EQ(unreceived_held(dev, "/ro"), std::make_pair(1u, 0u));
+  // The probe wrote back what was there.
+  for (size_t i = 0; i < sizeof(agnocast_entry); i++)
+    EXPECT_EQ(static_cast<unsigned char>(entries[i]), 0x5a) << i;
+  // One entry's room, all writable: received.
+  arg.entry_capacity = 1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_RECEIVE, &arg), 0);
+  EXPECT_EQ(arg.entry_count, 1u);
+  EXPECT_EQ(unreceived_held(dev, "/ro"), std::make_pair(0u, 1u));
+  munmap(area, 2 * page);
+}
+
 TEST_F(Device, RequestFlagsAndReservedMustBeZero) {
   auto r = poisoned_request<agnocast_register_process>();
   r.pool_fd = -1;

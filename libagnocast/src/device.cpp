@@ -53,6 +53,7 @@ static_assert(sizeof(agnocast_add_endpoint::type_name) == AGNOCAST_TYPE_NAME_MAX
 static_assert(AGNOCAST_SCHEMA_MAX == schema_max_bytes);
 static_assert(AGNOCAST_PUBLISHERS_PER_TOPIC_MAX == publishers_per_topic_max);
 static_assert(AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX == subscribers_per_topic_max);
+static_assert(Kernel::receive_entries_max == AGNOCAST_RECEIVE_BATCH);
 
 std::string errno_advice(int err) {
   switch (err) {

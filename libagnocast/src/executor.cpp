@@ -116,8 +116,9 @@ struct Executor::State {
     }
     std::shared_ptr<detail::Waitable> waitable = find(key);
     if (!waitable) return Outcome::idle;
+    const bool housekeeping = waitable->housekeeping();
     run_in_group(detail::PendingWork{std::move(waitable), epoll_fd, waitable_events});
-    return Outcome::handled;
+    return housekeeping ? Outcome::idle : Outcome::handled;
   }
 
   Outcome wait_and_handle(int timeout_ms) {

@@ -68,7 +68,8 @@ class Kernel {
   virtual ~Kernel() = default;
 
   // The most entries and pool grants one receive() returns; larger spans are not filled further.
-  static constexpr std::size_t receive_entries_max = 32;
+  // The module's batch: a receive of this many entries allocates nothing in the kernel.
+  static constexpr std::size_t receive_entries_max = 8;
   static constexpr std::size_t receive_pools_max = 8;
   // The most ids one release(), or the release list of one receive(), names.
   static constexpr std::size_t release_max = 256;

@@ -55,7 +55,10 @@ long system_msg_max() {
 OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
     : name_(name), descriptor_(-1), owner_pid_(::getpid()) {
   mq_attr attributes{};
-  attributes.mq_maxmsg = std::min(static_cast<long>(depth), system_msg_max());
+  // Room for two at least, so that a wake-up can take its notification after
+  // its callbacks (see drains_after()).
+  attributes.mq_maxmsg = std::min(std::max(static_cast<long>(depth), 2L), system_msg_max());
+  capacity_ = attributes.mq_maxmsg;
   attributes.mq_msgsize = sizeof(MqMsgAgnocast);
   const int flags = O_RDONLY | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
   descriptor_ = ::mq_open(name.c_str(), flags, queue_mode, &attributes);

@@ -14,8 +14,9 @@ namespace agnocast::detail {
 // The receiving end a callback subscriber creates and owns; unlinked on destruction.
 class OwnedQueue {
  public:
-  // Creates name for depth notifications (capped by fs.mqueue.msg_max),
-  // replacing a stale queue of that name. Throws QueueError naming the limit hit.
+  // Creates name for depth notifications (two at least, capped by
+  // fs.mqueue.msg_max), replacing a stale queue of that name. Throws
+  // QueueError naming the limit hit.
   OwnedQueue(const std::string& name, std::size_t depth);
   ~OwnedQueue();
   OwnedQueue(const OwnedQueue&) = delete;
@@ -25,6 +26,10 @@ class OwnedQueue {
   const std::string& name() const { return name_; }
   // Takes one notification without blocking; false when there was none.
   bool take_one() const;
+  // Whether a wake-up may take its notification after receiving: a full
+  // queue refuses a notification only while it holds two, so one still
+  // waits after the one that woke us is taken.
+  bool drains_after() const { return capacity_ >= 2; }
   // Queues one notification to ourselves (never blocks; a full queue is fine).
   void notify() const;
 
@@ -32,6 +37,7 @@ class OwnedQueue {
   std::string name_;
   mqd_t descriptor_;
   pid_t owner_pid_;
+  long capacity_ = 0;
 };
 
 // A publisher's sending ends, opened on first use and kept per subscriber id.

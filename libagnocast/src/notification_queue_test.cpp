@@ -42,6 +42,14 @@ TEST(NotificationQueue, CreatedWithTheSeedNameAndSize) {
   EXPECT_TRUE(attributes.mq_flags & O_NONBLOCK);
 }
 
+TEST(NotificationQueue, ADepthOneQueueHoldsTwoSoThatAWakeUpCanDrainAfterReceiving) {
+  OwnedQueue queue(queue_name(test_topic("two"), 0), 1);
+  mq_attr attributes{};
+  ASSERT_EQ(::mq_getattr(queue.fd(), &attributes), 0);
+  EXPECT_EQ(attributes.mq_maxmsg, std::min(2L, system_msg_max()));
+  EXPECT_EQ(queue.drains_after(), system_msg_max() >= 2);
+}
+
 TEST(NotificationQueue, DepthIsCappedBySystemLimit) {
   OwnedQueue queue(queue_name(test_topic("cap"), 0), 1000000);
   mq_attr attributes{};
@@ -67,8 +75,11 @@ TEST(NotificationQueue, SendersWakeTheOwnerAndNeverBlockWhenFull) {
 TEST(NotificationQueue, SelfNotificationWakes) {
   OwnedQueue queue(queue_name(test_topic("self"), 2), 1);
   queue.notify();
-  queue.notify();
   EXPECT_EQ(pending(queue.fd()), 1);
+  // A full queue (a depth-1 queue holds two) takes no more, and never blocks.
+  queue.notify();
+  queue.notify();
+  EXPECT_EQ(pending(queue.fd()), std::min(2L, system_msg_max()));
 }
 
 TEST(NotificationQueue, AnyUserMayWakeButOnlyTheOwnerReadsWhateverTheUmask) {

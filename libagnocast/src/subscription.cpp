@@ -1,6 +1,12 @@
+#include <sys/timerfd.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
 #include <exception>
 #include <mutex>
 #include <span>
@@ -19,17 +25,31 @@
 namespace agnocast::detail {
 namespace {
 
+// How long releases left by a wake-up may wait for the next one's receive
+// before they go in a release of their own: the longest a message dropped by
+// a callback, and so a dead publisher's pool, stays held when nothing else
+// arrives.
+constexpr std::chrono::milliseconds deferred_release_delay{4};
+
+timespec to_timespec(std::chrono::nanoseconds duration) {
+  const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(duration);
+  return timespec{static_cast<time_t>(seconds.count()),
+                  static_cast<long>((duration - seconds).count())};
+}
+
 // The kernel subscriber. It outlives its Subscription while any received
 // message is still held, so that memory is never reclaimed under a reader.
 // A callback subscriber's releases made while it handles a wake-up (messages
-// dropped by its callbacks) ride on its next receive of that wake-up; what is
-// left goes in one release when the wake-up ends, so that nothing stays held
-// until the next message (a dead publisher's pool would stay with it). A full
-// batch, and any release outside a wake-up, goes at once.
+// dropped by its callbacks) ride on its next receive: of that wake-up, or of
+// the next one.  What a wake-up leaves waits at most deferred_release_delay:
+// a one-shot timer in the executor's epoll set, armed only while releases
+// wait, then releases it in one call (see ReleaseTimer).  A full batch, what
+// a throwing callback's wake-up leaves, and any release outside a wake-up go
+// at once.
 class SubscriberEndpoint : public EntryOwner {
  public:
   // Releases one receive carries; a full batch is released at once.
-  static constexpr std::size_t release_batch = 32;
+  static constexpr std::size_t release_batch = Kernel::receive_entries_max;
   using ReleaseBatch = std::array<std::uint64_t, release_batch>;
 
   SubscriberEndpoint(Runtime& runtime, const EndpointRequest& request)
@@ -63,11 +83,39 @@ class SubscriberEndpoint : public EntryOwner {
     handling_wakeup_ = true;
   }
 
-  // Releases what still waits, in one call.
-  void end_wakeup() noexcept {
+  // What still waits rides on the next receive once the timer is armed
+  // (completed: no callback threw); else it goes now, in one call.
+  void end_wakeup(bool completed) noexcept {
     std::lock_guard lock(release_mutex_);
     handling_wakeup_ = false;
-    if (pending_count_ > 0) release_pending();
+    if (pending_count_ == 0) return;
+    if (completed && arm_deferred_release()) return;
+    release_pending();
+  }
+
+  // From now on, what a wake-up leaves waits for the next receive, at most
+  // until timer_fd (a timerfd the caller owns) expires.
+  void defer_releases(int timer_fd) {
+    std::lock_guard lock(release_mutex_);
+    timer_fd_ = timer_fd;
+  }
+
+  // The timer's descriptor is about to close: nothing waits any more.
+  void stop_deferring() noexcept {
+    if (!still_ours()) return;
+    std::lock_guard lock(release_mutex_);
+    timer_fd_ = -1;
+    timer_armed_ = false;
+    if (pending_count_ > 0 && !handling_wakeup_) release_pending();
+  }
+
+  // The timer expired: releases still waiting go now, unless a wake-up is
+  // under way (its receive takes them, or its end arms the timer again).
+  void release_deferred() noexcept {
+    if (!still_ours()) return;
+    std::lock_guard lock(release_mutex_);
+    timer_armed_ = false;
+    if (pending_count_ > 0 && !handling_wakeup_) release_pending();
   }
 
   // Moves the releases waiting for the next receive into batch; returns their number.
@@ -120,6 +168,16 @@ class SubscriberEndpoint : public EntryOwner {
   // False in a fork child: the endpoint and its references are the parent's.
   bool still_ours() const { return Runtime::current() == &runtime_; }
 
+  // With release_mutex_ held. False when there is no timer to wait for.
+  bool arm_deferred_release() noexcept {
+    if (timer_fd_ < 0) return false;
+    if (timer_armed_) return true;  // it expires soon enough already
+    const itimerspec once{timespec{}, to_timespec(deferred_release_delay)};
+    if (::timerfd_settime(timer_fd_, 0, &once, nullptr) != 0) return false;
+    timer_armed_ = true;
+    return true;
+  }
+
   // With release_mutex_ held.
   void release_pending() noexcept {
     try {
@@ -138,10 +196,37 @@ class SubscriberEndpoint : public EntryOwner {
   const EndpointId id_;
   std::mutex release_mutex_;
   bool handling_wakeup_ = false;
+  int timer_fd_ = -1;
+  bool timer_armed_ = false;
   ReleaseBatch pending_releases_{};
   std::size_t pending_count_ = 0;
   std::mutex spare_mutex_;  // releases come from any thread
   std::vector<EntryReference*> spare_references_;
+};
+
+// The deferred release's one-shot timer, in the executor's epoll set beside
+// its subscription.  Its expiry is housekeeping: spin_once() does not count it.
+class ReleaseTimer : public Waitable {
+ public:
+  ReleaseTimer(std::shared_ptr<CallbackGroup> group, std::shared_ptr<SubscriberEndpoint> endpoint)
+      : Waitable(std::move(group)),
+        fd_(::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK)),
+        endpoint_(std::move(endpoint)) {
+    if (fd_ < 0) throw Error(std::string("agnocast: timerfd_create: ") + std::strerror(errno));
+  }
+  ~ReleaseTimer() override { ::close(fd_); }
+
+  int wait_fd() const override { return fd_; }
+  bool housekeeping() const override { return true; }
+  void execute() override {
+    std::uint64_t expirations = 0;
+    if (::read(fd_, &expirations, sizeof expirations) != sizeof expirations) return;
+    endpoint_->release_deferred();
+  }
+
+ private:
+  const int fd_;
+  const std::shared_ptr<SubscriberEndpoint> endpoint_;
 };
 
 // Maps every granted pool (closing each descriptor) and throws the first failure.
@@ -179,6 +264,7 @@ struct SubscriptionBase::State {
   std::string topic;
   std::shared_ptr<SubscriberEndpoint> endpoint;
   std::unique_ptr<OwnedQueue> queue;
+  std::shared_ptr<ReleaseTimer> release_timer;
   std::mutex receive_mutex;
 };
 
@@ -195,12 +281,18 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
   // If the queue cannot be created, the endpoint's destructor removes the subscriber.
   state_->queue = std::make_unique<OwnedQueue>(
       agnocast::queue_name(topic, state_->endpoint->id().id), qos.depth());
+  state_->release_timer = std::make_shared<ReleaseTimer>(group(), state_->endpoint);
+  state_->endpoint->defer_releases(state_->release_timer->wait_fd());
+  register_waitable(*state_->node, state_->release_timer);
   // Entries published before the queue existed woke nobody: wake ourselves.
   state_->queue->notify();
 }
 
 SubscriptionBase::~SubscriptionBase() {
   state_->node->remove_waitable(key());
+  state_->node->remove_waitable(state_->release_timer->key());
+  state_->endpoint->stop_deferring();  // what waits goes now
+  state_->release_timer.reset();       // closes the timer, which leaves the epoll sets
   state_->endpoint.reset();  // removes the kernel subscriber unless messages are still held
   state_->queue.reset();     // then unlinks the queue
 }
@@ -209,6 +301,8 @@ const std::string& SubscriptionBase::topic() const { return state_->topic; }
 std::uint32_t SubscriptionBase::id() const { return state_->endpoint->id().id; }
 const std::string& SubscriptionBase::queue_name() const { return state_->queue->name(); }
 int SubscriptionBase::queue_fd() const { return state_->queue->fd(); }
+int SubscriptionBase::release_timer_fd() const { return state_->release_timer->wait_fd(); }
+void SubscriptionBase::release_deferred() { state_->release_timer->execute(); }
 
 std::size_t SubscriptionBase::handle_wakeup() {
   State& state = *state_;
@@ -217,19 +311,27 @@ std::size_t SubscriptionBase::handle_wakeup() {
   std::array<ReceivedEntry, Kernel::receive_entries_max> entries;
   std::array<PoolGrant, Kernel::receive_pools_max> pools;
   std::size_t delivered = 0;
-  // Take one notification, then receive until nothing is left: three system
-  // calls with the executor's wait whatever the depth, and one release at the
-  // end for what the callbacks dropped.  A publisher commits
-  // its entry before it notifies, so an entry this receive misses has a
-  // notification still to come, or one still queued (a full queue refuses
-  // one only while it holds another): either wakes us again.
-  state.queue->take_one();
+  // Receive until nothing is left, run the callbacks, then take the one
+  // notification that woke us: with the executor's wait, three system calls
+  // whatever the depth, the releases of what the callbacks dropped riding on
+  // the next wake-up's receive (or going in one call when the timer armed at
+  // the end of this one expires first).  A publisher commits its entry before it notifies, and the
+  // notification taken was queued before the receive (the executor runs a
+  // wake-up on one thread at a time), so its entry was received.  An entry
+  // this receive missed has a notification still to come, or one still
+  // queued (a queue refuses one only while full, and it holds two at least):
+  // either wakes us again.  A queue that holds one only (fs.mqueue.msg_max
+  // 1) is drained first instead.  A throwing callback leaves the
+  // notification queued, for the entries it did not reach.
+  const bool drain_after = state.queue->drains_after();
+  if (!drain_after) state.queue->take_one();
   SubscriberEndpoint::ReleaseBatch releases;
   SubscriberEndpoint& endpoint = *state.endpoint;
   endpoint.begin_wakeup();
   struct EndWakeup {
     SubscriberEndpoint& endpoint;
-    ~EndWakeup() { endpoint.end_wakeup(); }
+    const int exceptions = std::uncaught_exceptions();
+    ~EndWakeup() { endpoint.end_wakeup(std::uncaught_exceptions() == exceptions); }
   } end_wakeup{endpoint};
   for (;;) {
     const std::span<const std::uint64_t> released(releases.data(),
@@ -260,6 +362,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
     }
     if (result.remaining == 0) break;
   }
+  if (drain_after) state.queue->take_one();
   return delivered;
 }
 

@@ -480,10 +480,11 @@ TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
     EXPECT_EQ(pools_we_map(), 1U);
     finish.send();
     EXPECT_TRUE(exited_ok(wait_child(talker)));
-    // Its window goes with it; we hold nothing, so its pool is freed.
+    // Its window goes with it; what our callbacks dropped goes back by the
+    // deferred release while the executor spins, so its pool is freed.
     const auto deadline = std::chrono::steady_clock::now() + 10s;
     while (pools_we_map() != 0 && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(10ms);
+      executor.spin_once(10ms);
     }
     EXPECT_EQ(pools_we_map(), 0U);
   }
@@ -496,6 +497,55 @@ TEST(Lifecycle, ASubscriberReadsTheNextPoolOfADeadPublishersSlot) {
     EXPECT_EQ(received.seqs[10 + i], 100 + i);
   }
   EXPECT_TRUE(received.intact);
+}
+
+// What a callback drops rides on the next receive; when nothing follows,
+// the executor's deferred release gives it back within a few milliseconds,
+// and with it the pool of a publisher that died meanwhile.
+TEST(Lifecycle, ADroppedMessageAndADeadPublishersPoolGoBackWithoutAnotherMessage) {
+  const std::string topic = unique_topic("deferred");
+  agnocast::Node node{"dropper"};
+  Received received;
+  auto subscription = node.create_subscription<Message>(topic, QoS{10}, received.recorder());
+  agnocast::SingleThreadedExecutor executor;
+  executor.add_node(node);
+  spin_until_quiet(executor, 100ms);  // the subscription's own first notification
+  auto held = [&] {
+    const auto info = agnocast::topic_info(topic);
+    return info && info->subscribers.size() == 1 ? info->subscribers[0].held : ~0U;
+  };
+  auto pools_we_map = [] {
+    for (const auto& process : agnocast::list_processes()) {
+      if (process.pid == ::getpid()) return process.pools_mapped;
+    }
+    return ~0U;
+  };
+  Pipe published, finish;
+  const pid_t talker = fork_child([&] {
+    agnocast::Node talker_node{"talker"};
+    auto publisher = talker_node.create_publisher<Message>(topic, QoS{1});
+    publish(*publisher, 7, 1024);
+    published.send();
+    return finish.receive() == 'x' ? 0 : 1;
+  });
+  ASSERT_EQ(published.receive(), 'x');
+  ASSERT_TRUE(spin_until(executor, [&] { return received.seqs.size() == 1; }));
+  EXPECT_TRUE(received.intact);
+  // Dropped by the callback, it waits for a receive that will not come.
+  EXPECT_EQ(held(), 1U);
+  finish.send();
+  EXPECT_TRUE(exited_ok(wait_child(talker)));
+  EXPECT_EQ(pools_we_map(), 1U) << "the dead publisher's pool stays while we hold its message";
+
+  const auto start = std::chrono::steady_clock::now();
+  while (pools_we_map() != 0 && std::chrono::steady_clock::now() - start < 10s) {
+    EXPECT_FALSE(executor.spin_once(5ms)) << "the deferred release is not a callback";
+  }
+  const auto took = std::chrono::steady_clock::now() - start;
+  EXPECT_EQ(pools_we_map(), 0U);
+  // 4 ms in the library; the rest is the emulator's scheduling.
+  EXPECT_LT(took, 500ms);
+  EXPECT_EQ(received.seqs.size(), 1U);
 }
 
 TEST(Counters, PublishedBytesCountThePayloadFilledIn) {

@@ -259,6 +259,12 @@ struct agnocast_pool {
 /* Most entries and pools one RECEIVE returns (remaining counts the rest). */
 #define AGNOCAST_RECEIVE_ENTRIES_MAX 256
 #define AGNOCAST_RECEIVE_POOLS_MAX 8
+/*
+ * A RECEIVE of at most this many entries that releases at most as many, and
+ * a RELEASE of at most as many, allocate nothing in the kernel: the batch a
+ * subscriber should ask for.
+ */
+#define AGNOCAST_RECEIVE_BATCH 8
 
 /*
  * AGNOCAST_IOC_RECEIVE (callback subscribers)

@@ -104,6 +104,11 @@ class SubscriptionBase : public Waitable {
 
   int wait_fd() const override { return queue_fd(); }
   void execute() override { handle_wakeup(); }
+  // The one-shot timer that bounds how long releases wait for the next
+  // wake-up's receive; readable once expired, when release_deferred() (run by
+  // the executor) releases them.
+  int release_timer_fd() const;
+  void release_deferred();
 
  protected:
   SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,

@@ -18,6 +18,9 @@ class Waitable {
   virtual int wait_fd() const = 0;
   // Handles the descriptor's readiness; called by one thread at a time.
   virtual void execute() = 0;
+  // Work the library does for itself (no callback runs): an executor's
+  // spin_once() keeps waiting after it.
+  virtual bool housekeeping() const { return false; }
 
   std::uint64_t key() const { return key_; }  // unique in the process, for executors
   const std::shared_ptr<CallbackGroup>& group() const { return group_; }

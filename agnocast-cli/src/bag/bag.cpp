@@ -1,4 +1,4 @@
-// agnocast-cli bag: record and info, wired into CLI11.
+// agnocast-cli bag: record, info and play, wired into CLI11.
 #include "bag/bag.hpp"
 
 #include <memory>
@@ -51,6 +51,20 @@ void set_info_command(CLI::App& bag, Context& context) {
                {.build = [path] { return bag_info_json(*path); }, .render = bag_info_table});
 }
 
+void set_play_command(CLI::App& bag, Context& context) {
+  auto options = std::make_shared<BagPlayOptions>();
+  CLI::App* play = bag.add_subcommand(
+      "play", "Publish an MCAP file's messages on agnocast topics with their original spacing");
+  play->add_option("FILE", options->path, "The .mcap file")->required();
+  play->add_option("--rate", options->rate, "Speed factor (default 1)")->check(CLI::PositiveNumber);
+  play->add_flag("--loop", options->loop, "Start over at the end, until SIGINT/SIGTERM");
+  play->add_option("--topics", options->topics, "Only these topics");
+  play->add_option("--start-offset", options->start_offset_s, "Skip the first SECONDS of the file")
+      ->check(CLI::NonNegativeNumber);
+  bind_command(*play, context,
+               {.stream = [options](std::ostream& out) { return bag_play(*options, out); }});
+}
+
 }  // namespace
 
 void set_bag_command(CLI::App& app, Context& context) {
@@ -58,6 +72,7 @@ void set_bag_command(CLI::App& app, Context& context) {
   bag->require_subcommand(1);
   set_record_command(*bag, context);
   set_info_command(*bag, context);
+  set_play_command(*bag, context);
 }
 
 }  // namespace agnocast::cli

@@ -38,6 +38,18 @@ struct BagRecordOptions {
 // topic that does not exist or has no schema.
 int bag_record(const BagRecordOptions& options, std::ostream& out);
 
+struct BagPlayOptions {
+  std::string path;
+  double rate = 1.0;
+  bool loop = false;
+  std::vector<std::string> topics;  // empty: every topic
+  double start_offset_s = 0;
+};
+
+// Publishes the file's messages with their original spacing (divided by
+// rate). Throws InputError for a file it cannot read or play, naming why.
+int bag_play(const BagPlayOptions& options, std::ostream& out);
+
 // The .mcap path `output` names: a file as given, or a new one named after
 // `unix_seconds` (local time) inside a directory (an existing one, or one
 // ending in '/'; created).

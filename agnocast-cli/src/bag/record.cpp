@@ -169,6 +169,18 @@ class Recorder {
       return false;
     }
     topic->metadata = channel_metadata(name);
+    // What bag play needs to publish the type a compiled subscriber expects.
+    char hash[17];
+    std::snprintf(hash, sizeof hash, "%016llx",
+                  static_cast<unsigned long long>(topic->subscription->type_hash()));
+    topic->metadata["agnocast_type_hash"] = hash;
+    std::string hex;
+    for (const std::uint8_t byte : topic->subscription->schema_blob()) {
+      static constexpr char digits[] = "0123456789abcdef";
+      hex += digits[byte >> 4];
+      hex += digits[byte & 0xF];
+    }
+    topic->metadata["agnocast_schema"] = hex;
     if (writer_) register_topic(*topic);
     recorded_.insert(name);
     topics_.push_back(std::move(topic));

@@ -200,16 +200,22 @@ std::string type_fields(const Schema& schema, const SchemaType& type) {
     } else if (const char* name = primitive_name(field.kind)) {
       text += name;
       if (field.kind == FieldKind::String && field.string_bound != 0) {
-        text += "<=" + std::to_string(field.string_bound);
+        text += "<=";
+        text += std::to_string(field.string_bound);
       }
     } else {
       throw cdr::Error("field '" + field.name + "' of " + type.name +
                        " holds opaque bytes, which have no .msg form");
     }
+    // Appended piece by piece: GCC 12 at -O3 misreads "[" + std::string as overlapping.
     if (field.shape == FieldShape::Array) {
-      text += "[" + std::to_string(field.array_length) + "]";
+      text += '[';
+      text += std::to_string(field.array_length);
+      text += ']';
     } else if (field.shape == FieldShape::Sequence) {
-      text += field.sequence_bound != 0 ? "[<=" + std::to_string(field.sequence_bound) + "]" : "[]";
+      text += field.sequence_bound != 0 ? "[<=" : "[";
+      if (field.sequence_bound != 0) text += std::to_string(field.sequence_bound);
+      text += ']';
     }
     text += ' ';
     text += field.name;

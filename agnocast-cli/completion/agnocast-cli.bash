@@ -13,11 +13,33 @@ _agnocast_cli() {
     [[ $word == -* ]] || words+=("$word")
   done
   case $prev in
-    --window | --count | --timeout | --status-file) return ;;
+    --window | --count | --timeout | --status-file | --max-size | --duration | --rate | --start-offset) return ;;
+    --compression) COMPREPLY=($(compgen -W "zstd lz4 none" -- "$cur")); return ;;
+    -o | --output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
   esac
   local candidates
   case "${words[0]-} ${words[1]-}" in
-    " ") candidates="topic queue node process daemon doctor policy version --json --help --version" ;;
+    " ") candidates="topic queue node process daemon doctor policy bag version --json --help --version" ;;
+    "bag ") candidates="record info play" ;;
+    "bag record")
+      if [[ $cur == -* ]]; then
+        candidates="--output --all --compression --max-size --duration --json --help"
+      else
+        candidates=$(_agnocast_cli_names topic)
+      fi
+      ;;
+    "bag info" | "bag play")
+      if [[ $cur == -* ]]; then
+        if [[ ${words[1]} == play ]]; then
+          candidates="--rate --loop --topics --start-offset --json --help"
+        else
+          candidates="--json --help"
+        fi
+      else
+        COMPREPLY=($(compgen -f -- "$cur"))
+        return
+      fi
+      ;;
     "topic ") candidates="list info hz echo" ;;
     "queue ") candidates="list" ;;
     "node ") candidates="list info" ;;

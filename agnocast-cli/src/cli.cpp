@@ -4,6 +4,7 @@
 #include <exception>
 #include <string_view>
 
+#include "bag/bag.hpp"
 #include "commands.hpp"
 
 namespace agnocast::cli {
@@ -115,6 +116,7 @@ int run_cli(int argc, const char* const* argv_given, InspectionSource& source, s
   set_doctor_command(app, context);
   set_policy_command(app, context);
   set_version_command(app, context);
+  set_bag_command(app, context);
   // Shown in --help; run_cli turns it into the version command before parsing.
   app.add_flag("--version")->description("Same as the version command");
 
@@ -134,6 +136,8 @@ int run_cli(int argc, const char* const* argv_given, InspectionSource& source, s
 
   try {
     return run_chosen(*context.chosen, context.json, out, err);
+  } catch (const InputError& e) {
+    return fail(exit_usage_error, e.what(), context.json, out, err);
   } catch (const std::exception& e) {
     // ModuleNotLoaded and the CLI's own errors already name the fix.
     return fail(exit_runtime_error, e.what(), context.json, out, err);

@@ -24,6 +24,13 @@ class CliError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Input the user gave that cannot be used (a file that is not MCAP, a topic
+// that does not exist): a usage error, exit 2.
+class InputError : public CliError {
+ public:
+  using CliError::CliError;
+};
+
 // One runnable command: build its value, render it for humans, derive its exit code.
 struct Command {
   std::function<nlohmann::json()> build = {};

@@ -64,7 +64,7 @@ class Writer {
     cdr_write(*this, message);
   }
 
- private:
+  // count elements as a fixed array holds them (no count before them).
   template <class E>
   void write_elements(const E* elements, std::size_t count) {
     if constexpr (std::is_arithmetic_v<E>) {
@@ -77,6 +77,7 @@ class Writer {
     }
   }
 
+ private:
   // Not inlined: GCC 12 at -O3, seeing a constant size grow a vector, warns
   // -Warray-bounds about the vector's own reallocation.
   [[gnu::noinline]] void append(const void* bytes, std::size_t size) {

@@ -466,9 +466,9 @@ series in the same boot, so ratios compare like with like.
   other work on the machine (p99s of 10 ms and more are the host preempting
   the emulator). Series that need parallel cores are measured here —
   `topics_64` (63 busy topics beside the measured one) and fan-out under
-  parallel load — over 20 or more short rounds in shuffled order, each ratio
-  with a 95 % bootstrap interval of its median over rounds; a target counts as
-  met only when the whole interval is under it.
+  parallel load — over many short rounds in shuffled order (the table above
+  says how many), each ratio with a 95 % bootstrap interval of its median over
+  rounds; a target counts as met only when the whole interval is under it.
 
 Latency is one way: from the publish call, payload already written, to the
 first line of the subscriber's callback, one message in flight, both sides

@@ -197,14 +197,17 @@ json machine_json() {
       break;
     }
   }
-  return {{"kernel", names.release},
-          {"cpu", cpu},
-          {"cpus", sysconf(_SC_NPROCESSORS_ONLN)},
-          {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024},
-          {"system", first_line_of("/sys/devices/virtual/dmi/id/sys_vendor") + " " +
-                         first_line_of("/sys/devices/virtual/dmi/id/product_name")},
-          {"clocksource",
-           first_line_of("/sys/devices/system/clocksource/clocksource0/current_clocksource")}};
+  return {
+      {"kernel", names.release},
+      {"cpu", cpu},
+      {"cpus", sysconf(_SC_NPROCESSORS_ONLN)},
+      {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024},
+      {"system", first_line_of("/sys/devices/virtual/dmi/id/sys_vendor") + " " +
+                     first_line_of("/sys/devices/virtual/dmi/id/product_name")},
+      {"clocksource",
+       first_line_of("/sys/devices/system/clocksource/clocksource0/current_clocksource")},
+      {"address_randomization", (personality(0xffffffff) & ADDR_NO_RANDOMIZE) == 0 &&
+                                    first_line_of("/proc/sys/kernel/randomize_va_space") != "0"}};
 }
 
 // A ratio measured in every round: numerator / denominator of that round's

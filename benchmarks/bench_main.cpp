@@ -2,6 +2,7 @@
 // the ratios between agnocast and its yardsticks hold even where absolute
 // times do not (the test VM runs under TCG emulation on a shared host).
 #include <poll.h>
+#include <sys/personality.h>
 #include <sys/utsname.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -196,14 +197,17 @@ json machine_json() {
       break;
     }
   }
-  return {{"kernel", names.release},
-          {"cpu", cpu},
-          {"cpus", sysconf(_SC_NPROCESSORS_ONLN)},
-          {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024},
-          {"system", first_line_of("/sys/devices/virtual/dmi/id/sys_vendor") + " " +
-                         first_line_of("/sys/devices/virtual/dmi/id/product_name")},
-          {"clocksource",
-           first_line_of("/sys/devices/system/clocksource/clocksource0/current_clocksource")}};
+  return {
+      {"kernel", names.release},
+      {"cpu", cpu},
+      {"cpus", sysconf(_SC_NPROCESSORS_ONLN)},
+      {"memory_mib", sysconf(_SC_PHYS_PAGES) / 1024 * sysconf(_SC_PAGE_SIZE) / 1024},
+      {"system", first_line_of("/sys/devices/virtual/dmi/id/sys_vendor") + " " +
+                     first_line_of("/sys/devices/virtual/dmi/id/product_name")},
+      {"clocksource",
+       first_line_of("/sys/devices/system/clocksource/clocksource0/current_clocksource")},
+      {"address_randomization", (personality(0xffffffff) & ADDR_NO_RANDOMIZE) == 0 &&
+                                    first_line_of("/proc/sys/kernel/randomize_va_space") != "0"}};
 }
 
 // A ratio measured in every round: numerator / denominator of that round's
@@ -247,11 +251,32 @@ json syscalls_json(const bench::SteadyResult& steady) {
           {"messages", subscriber["messages"]}};
 }
 
+// agnocast-bench-breakdown's report, run as a program of its own (it
+// replaces the C library's calls libagnocast makes); null when it fails.
+json cost_breakdown(const std::string& program, bool smoke) {
+  const std::string command = program + (smoke ? " --count 5 --rounds 5" : "");
+  FILE* output = popen(command.c_str(), "r");
+  if (!output) return nullptr;
+  std::string text;
+  char buffer[4096];
+  while (std::size_t n = std::fread(buffer, 1, sizeof buffer, output)) text.append(buffer, n);
+  if (pclose(output) != 0) {
+    std::cerr << "agnocast-bench: " << program << " failed\n";
+    return nullptr;
+  }
+  try {
+    return json::parse(text);
+  } catch (const std::exception& error) {
+    std::cerr << "agnocast-bench: " << program << ": " << error.what() << "\n";
+    return nullptr;
+  }
+}
+
 json cpu_json(const bench::CpuPerMessage& cpu) {
   return {{"publisher", cpu.publisher_us}, {"subscriber", cpu.subscriber_us}};
 }
 
-json run(const Plan& plan, const std::string& iceoryx_role) {
+json run(const Plan& plan, const std::string& iceoryx_role, const std::string& breakdown_program) {
   json report;
   report["mode"] = plan.icount ? "icount" : "ordinary";
   report["machine"] = machine_json();
@@ -471,6 +496,19 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
                   : json{{"agnocast", bench::median(agnocast_slopes)},
                          {"mqueue", bench::median(mqueue_slopes)}};
 
+  std::cerr << "the cost of one message, call by call...\n";
+  json breakdown = cost_breakdown(breakdown_program, plan.smoke);
+  if (breakdown.is_object()) {
+    // The bare hop, measured above in the same boot: mq_send to the
+    // receiver's return from mq_receive, receiver asleep in epoll_wait
+    // (agnocast's executor) or in mq_receive.
+    breakdown["reference"]["mqueue_hop_epoll_ns"] =
+        samples.round_p50(all_rounds, "mqueue_epoll_floor", "1 B") * 1000;
+    breakdown["reference"]["mqueue_hop_ns"] =
+        samples.round_p50(all_rounds, "mqueue_floor", "1 B") * 1000;
+  }
+  report["cost_breakdown"] = breakdown;
+
   std::cerr << "system calls and CPU time at 1 kHz...\n";
   // CPU time without counters, as iceoryx's and the floor's; then the counts.
   const bench::SteadyResult uncounted =
@@ -498,6 +536,23 @@ json run(const Plan& plan, const std::string& iceoryx_role) {
   return report;
 }
 
+// Measures agnocast's 64 B series twice in a row and compares the p50s: in
+// icount mode they agree (within `tolerance`), whatever the host does.
+int repeat_check(std::size_t samples, double tolerance) {
+  std::vector<double> p50s;
+  for (int run = 0; run < 2; ++run) {
+    const Cell cell{"agnocast", "64 B",
+                    [&](auto&) { return bench::run_agnocast_latency(64, samples, 1).front(); }};
+    std::vector<std::int64_t> measured, extra;
+    if (!run_isolated(cell, 300, measured, extra)) return 1;
+    p50s.push_back(bench::summarize(measured).p50_us * 1000);
+  }
+  const double difference = std::abs(p50s[1] - p50s[0]) / std::min(p50s[0], p50s[1]);
+  std::printf("agnocast 64 B p50: %.0f ns, then %.0f ns: %.3f %% apart (at most %.1f %%)\n",
+              p50s[0], p50s[1], difference * 100, tolerance * 100);
+  return difference <= tolerance ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -505,9 +560,9 @@ int main(int argc, char** argv) {
       "agnocast-bench: latency, fan-out, system calls and CPU time against iceoryx and "
       "baselines"};
   bool json_output = false, smoke = false;
-  std::string iceoryx_role =
-      (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "agnocast-bench-iceoryx")
-          .string();
+  const std::filesystem::path here = std::filesystem::read_symlink("/proc/self/exe").parent_path();
+  std::string iceoryx_role = (here / "agnocast-bench-iceoryx").string();
+  std::string breakdown_program = (here / "agnocast-bench-breakdown").string();
   Plan plan;
   app.add_flag("--json", json_output, "print one JSON object instead of Markdown tables");
   app.add_flag("--smoke", smoke,
@@ -518,17 +573,35 @@ int main(int argc, char** argv) {
                      ->check(CLI::Range(2, 1000));
   app.add_option("--seed", plan.seed, "seed of the rounds' shuffled order");
   app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
+  app.add_option("--breakdown-program", breakdown_program, "the cost breakdown program");
   app.add_flag("--icount", plan.icount,
                "the VM runs in QEMU's instruction-counting mode: fewer rounds, single-valued "
                "ratios, no series that needs parallel cores");
   app.add_option("--host-cpu", plan.host_cpu, "the host's CPU, for the report");
   app.add_option("--qemu-version", plan.qemu_version, "QEMU's version, for the report");
   app.add_option("--qemu-flags", plan.qemu_flags, "QEMU's accelerator flags, for the report");
+  bool repeat = false;
+  app.add_flag("--repeat-check", repeat,
+               "measure agnocast's 64 B p50 twice; fail if they differ by more than 1 % (a check "
+               "of icount mode's repeatability)");
   std::string render;
   app.add_option("--render", render,
                  "measure nothing: print a saved --json report as Markdown tables");
+  std::string readme;
+  app.add_option("--readme", readme,
+                 "measure nothing: print benchmarks/README.md from a report of both modes");
   CLI11_PARSE(app, argc, argv);
 
+  if (!readme.empty()) {
+    std::ifstream saved(readme);
+    try {
+      bench::print_readme(json::parse(saved));
+    } catch (const std::exception& error) {
+      std::cerr << "agnocast-bench: " << readme << ": " << error.what() << "\n";
+      return 1;
+    }
+    return 0;
+  }
   if (!render.empty()) {
     std::ifstream saved(render);
     try {
@@ -540,10 +613,21 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  // In icount mode the address layout is fixed (no ASLR, like setarch -R):
+  // where a buffer falls within its page changes how many pages the kernel
+  // checks, so a randomized layout moved a p50 by ~4 % from boot to boot.
+  // The roles are forked or started from here and inherit it.
+  const int persona = personality(0xffffffff);
+  if (plan.icount && persona != -1 && (persona & ADDR_NO_RANDOMIZE) == 0 &&
+      personality(static_cast<unsigned long>(persona) | ADDR_NO_RANDOMIZE) != -1) {
+    execv("/proc/self/exe", argv);
+    std::cerr << "agnocast-bench: could not start again without address randomization\n";
+  }
+  if (repeat) return repeat_check(plan.latency_samples, 0.01);
   if (smoke) plan.make_smoke();
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
   try {
-    json report = run(plan, iceoryx_role);
+    json report = run(plan, iceoryx_role, breakdown_program);
     if (json_output) {
       std::cout << report.dump() << "\n";
     } else {

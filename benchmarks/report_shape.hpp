@@ -14,4 +14,8 @@ std::vector<std::string> report_shape_errors(const nlohmann::ordered_json& repor
 // The report as the Markdown tables the README shows.
 void print_markdown(const nlohmann::ordered_json& report);
 
+// benchmarks/README.md from one report of both modes ({"icount": report,
+// "ordinary": report, ...}, as scripts/bench --write-readme keeps it).
+void print_readme(const nlohmann::ordered_json& combined);
+
 }  // namespace agnocast::bench

@@ -5,7 +5,7 @@
 # AGNOCAST_KERNEL_RELEASE and AGNOCAST_VM_KERNEL_IMAGE describe the stock
 # kernel, which the native build and the single-kernel tests use.
 set(KDIR "$ENV{KDIR}" CACHE PATH "Kernel build directory the module is built against")
-# OFF: user space only (packages, the demo): no
+# OFF: user space only (scripts/make-packages): no
 # agnocast.ko, no VM suite.
 option(AGNOCAST_BUILD_MODULE "Build agnocast.ko and register the VM suite" ON)
 # Empty: every kernel tests/vm/kernels lists as ready.  A list (e.g. "stock")

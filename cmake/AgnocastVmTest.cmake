@@ -3,19 +3,22 @@
 # per test (vm.<NAME>).
 #
 #   agnocast_add_vm_test(NAME name COMMAND program [args...]
-#                        [TIMEOUT seconds] [TARGETS target...] [FILES path...])
+#                        [TIMEOUT seconds] [TARGETS target...] [FILES path...]
+#                        [OWN_FILES path...])
 #
 # COMMAND's program is a target (its binary is copied into the VM) or a file
 # path (copied too); either is run by its file name from /opt/agnocast/bin,
 # which is on PATH.  TARGETS and FILES are further programs or data the test
 # needs, copied to the same place with every shared library they link.
+# OWN_FILES are copied likewise, but only into the boots that run this test
+# (large files, such as node, that no other kernel's boot should carry).
 # The VM runs each test as root in a fresh /tmp/vm-tests/<NAME> directory with
 # agnocast.ko freshly loaded with default parameters, default mqueue limits
 # and empty /dev/mqueue and /dev/shm (the module path is $AGNOCAST_MODULE),
 # one after another;
 # TIMEOUT (default 120 s) bounds one test.
 function(agnocast_add_vm_test)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES;OWN_FILES")
   if(NOT arg_NAME OR NOT arg_COMMAND)
     message(FATAL_ERROR "agnocast_add_vm_test needs NAME and COMMAND")
   endif()
@@ -46,6 +49,10 @@ function(agnocast_add_vm_test)
   set(lines)
   foreach(file IN LISTS files)
     string(APPEND lines "file\t${file}\n")
+  endforeach()
+  foreach(file IN LISTS arg_OWN_FILES)
+    get_filename_component(file "${file}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    string(APPEND lines "file\t${file}\t${arg_NAME}\n")
   endforeach()
   string(APPEND lines "test\t${arg_NAME}\t${arg_TIMEOUT}\t${program_name} ${args}\n")
   set_property(GLOBAL APPEND_STRING PROPERTY AGNOCAST_VM_MANIFEST "${lines}")

@@ -3,7 +3,7 @@
 //       /fg_chatter (std_msgs/String) every 50 ms, values derived from a counter
 //       n as check-foxglove.mjs expects; appends every std_msgs/String taken on
 //       /fg_from_client to RECEIVED, one line each.
-//   foxglove_peer fast WINDOWS  publishes a 64 KiB PointCloud2 on /fg_fast at
+//   foxglove_peer fast WINDOWS  publishes a 16 KiB PointCloud2 on /fg_fast at
 //       1 kHz and appends, every 500 ms, one JSON line: messages published so
 //       far and the publish() call's p50 and maximum in that window (µs).
 // Runs until SIGTERM.
@@ -39,8 +39,8 @@ void fill_cloud(sensor_msgs::msg::PointCloud2& cloud, std::uint32_t n, std::size
   cloud.row_step = static_cast<std::uint32_t>(4 * points);
   cloud.is_dense = true;
   cloud.data.resize(4 * points);
-  for (std::size_t i = 0; i < points; ++i) {
-    const float value = static_cast<float>(n) + 0.5F * static_cast<float>(i % 3);
+  for (std::size_t i = 0; i < std::min<std::size_t>(points, 3); ++i) {
+    const float value = static_cast<float>(n) + 0.5F * static_cast<float>(i);
     std::memcpy(cloud.data.data() + 4 * i, &value, 4);
   }
 }
@@ -82,7 +82,7 @@ int fast(const std::string& windows_path) {
   auto window_end = next + 500ms;
   while (agnocast::ok()) {
     auto cloud = points->borrow_loaned_message();
-    fill_cloud(*cloud, ++n, 16384);  // 64 KiB of points
+    fill_cloud(*cloud, ++n, 4096);  // 16 KiB of points
     const auto before = std::chrono::steady_clock::now();
     points->publish(std::move(cloud));
     calls_us.push_back(

@@ -1,6 +1,8 @@
 // agnocast-foxglove [--address A] [--port P] [--max-clients N] [--topics REGEX]
 // Exit 0 after SIGINT/SIGTERM, 1 on a runtime error (cannot listen, no
 // module), 2 on a usage error.
+#include <arpa/inet.h>
+
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <regex>
@@ -29,7 +31,15 @@ int main(int argc, char** argv) {
   app.add_option("--address", options.websocket.address,
                  "IP address to listen on; anything but loopback lets every host that reaches "
                  "it read every topic")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(
+          [](const std::string& address) {
+            unsigned char bytes[16];
+            const bool ip = ::inet_pton(AF_INET, address.c_str(), bytes) == 1 ||
+                            ::inet_pton(AF_INET6, address.c_str(), bytes) == 1;
+            return ip ? std::string() : "'" + address + "' is not an IPv4 or IPv6 address";
+          },
+          "IP");
   app.add_option("--port", options.websocket.port, "TCP port to listen on (0: any free one)")
       ->capture_default_str();
   app.add_option("--max-clients", options.websocket.max_clients,

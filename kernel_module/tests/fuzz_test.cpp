@@ -28,11 +28,13 @@
 // A failure prints the seed and the last operations of the thread that saw
 // it.  The VM bed checks the kernel log.
 //
-// usage: agnocast_fuzz_test [SECONDS [PROCESSES]] [--ops N] [--seed S] [--long]
+// usage: agnocast_fuzz_test [SECONDS [PROCESSES]] [--ops N] [--seed S] [--long] [--caps]
 //   Runs SECONDS (default 30) and on until N operations (default 0) were
 //   issued.  --long: 4 hours and 10^6 operations, unless given otherwise.
 //   --seed replays the workers' random choices of an earlier run (the
-//   interleaving of processes is the scheduler's).
+//   interleaving of processes is the scheduler's) and whether the module is
+//   reloaded with small caps ($AGNOCAST_MODULE, a third of the seeds;
+//   --caps: always).
 #include <dirent.h>
 #include <poll.h>
 #include <pthread.h>
@@ -1477,6 +1479,27 @@ bool parameters_fixed(const std::map<std::string, std::string>& at_start) {
   return ok;
 }
 
+// Since the parameters cannot change under the workers, a third of the runs
+// (by seed; --caps: every one) reload the module with small caps before
+// anything opens it, so that the caps are hit in the storm: endpoints per
+// process, entries held per subscriber, topics per namespace (each of the
+// two namespaces has its own).
+const char kSmallCaps[] =
+    "max_endpoints_per_process=6 max_held_per_subscriber=4 max_topics_per_namespace=5";
+bool reload_module(const char* params) {
+  const char* path = std::getenv("AGNOCAST_MODULE");
+  if (!path) return false;
+  eventually(
+      [] { return syscall(SYS_delete_module, "agnocast", O_NONBLOCK) == 0 || errno == ENOENT; });
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  bool loaded = syscall(SYS_finit_module, fd, params, 0) == 0;
+  close(fd);
+  // As the VM bed (and the shipped udev rule) does: group agnocast may use it.
+  return loaded && eventually([] { return access(AGNOCAST_DEVICE_PATH, F_OK) == 0; }) &&
+         chown(AGNOCAST_DEVICE_PATH, static_cast<uid_t>(-1), kAgnocastGroup) == 0;
+}
+
 // agnocastd beside the fuzzer, reloading configurations with other access
 // policies (and some that do not parse) on SIGHUP while the workers run.
 const char* const kDaemonConfigs[] = {
@@ -1627,6 +1650,7 @@ int main(int argc, char** argv) {
   int seconds = -1, nprocs = 6;
   long long min_ops = -1;
   bool long_mode = std::getenv("AGNOCAST_FUZZ_LONG") != nullptr;
+  bool caps = false;
   uint64_t base_seed = 0;
   bool seeded = false;
   int positional = 0;
@@ -1634,6 +1658,8 @@ int main(int argc, char** argv) {
     std::string a = argv[i];
     if (a == "--long") {
       long_mode = true;
+    } else if (a == "--caps") {
+      caps = true;
     } else if (a == "--ops" && i + 1 < argc) {
       min_ops = std::atoll(argv[++i]);
     } else if (a == "--seed" && i + 1 < argc) {
@@ -1659,6 +1685,14 @@ int main(int argc, char** argv) {
       mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
   std::mt19937_64 rng(base_seed);
   bool ok = true;
+  if ((caps || base_seed % 3 == 0) && (caps || std::getenv("AGNOCAST_MODULE"))) {
+    caps = reload_module(kSmallCaps);
+    std::printf(
+        "fuzz: %s: %s\n",
+        caps ? "the module reloaded with small caps" : "FAIL: could not reload $AGNOCAST_MODULE",
+        kSmallCaps);
+    ok &= caps;
+  }
 
   // The second IPC namespace; descriptors of both, inherited by every
   // worker (across exec too).
@@ -1830,6 +1864,21 @@ int main(int argc, char** argv) {
                      " at most during, " + std::to_string(slab_after) + " after")
                         .c_str()
                   : ("not counted: " + slab_note).c_str());
+  if (caps) {
+    // Each cap refuses with its own errno (the UAPI header's list).
+    uint64_t endpoints = sh->count[kAddPublisher][EMFILE] + sh->count[kAddSubscriber][EMFILE];
+    uint64_t topics = sh->count[kAddPublisher][ENFILE] + sh->count[kAddSubscriber][ENFILE];
+    uint64_t held = sh->count[kReceive][EDQUOT] + sh->count[kTake][EDQUOT];
+    std::printf(
+        "fuzz: caps hit: endpoints per process %llu, topics per namespace %llu, held "
+        "entries %llu\n",
+        static_cast<unsigned long long>(endpoints), static_cast<unsigned long long>(topics),
+        static_cast<unsigned long long>(held));
+    if (!endpoints && !topics && !held) {
+      std::printf("fuzz: FAIL: the module has small caps, yet no cap was hit\n");
+      ok = false;
+    }
+  }
   if (nprocs >= 3 && !sh->ns_workers) {
     std::printf("fuzz: FAIL: no worker ran in the second IPC namespace\n");
     ok = false;
@@ -1845,8 +1894,8 @@ int main(int argc, char** argv) {
     ok = false;
   }
   if (!clean) ok = false;
-  std::printf("fuzz: %s (seed %llu; replay: agnocast_fuzz_test %d %d --ops %lld --seed %llu)\n",
+  std::printf("fuzz: %s (seed %llu; replay: agnocast_fuzz_test %d %d --ops %lld --seed %llu%s)\n",
               ok ? "PASS" : "FAIL", static_cast<unsigned long long>(base_seed), seconds, nprocs,
-              min_ops, static_cast<unsigned long long>(base_seed));
+              min_ops, static_cast<unsigned long long>(base_seed), caps ? " --caps" : "");
   return ok ? 0 : 1;
 }

@@ -28,13 +28,14 @@
 // A failure prints the seed and the last operations of the thread that saw
 // it.  The VM bed checks the kernel log.
 //
-// usage: agnocast_fuzz_test [SECONDS [PROCESSES]] [--ops N] [--seed S] [--long] [--caps]
+// usage: agnocast_fuzz_test [SECONDS [PROCESSES]] [--ops N] [--seed S] [--long]
+//                           [--caps | --no-caps]
 //   Runs SECONDS (default 30) and on until N operations (default 0) were
 //   issued.  --long: 4 hours and 10^6 operations, unless given otherwise.
 //   --seed replays the workers' random choices of an earlier run (the
 //   interleaving of processes is the scheduler's) and whether the module is
 //   reloaded with small caps ($AGNOCAST_MODULE, a third of the seeds;
-//   --caps: always).
+//   --caps: always, --no-caps: never).
 #include <dirent.h>
 #include <poll.h>
 #include <pthread.h>
@@ -430,7 +431,7 @@ struct Worker {
 
   // Checks the message of a held entry; false only on a wrong message.
   // Entries of pools this process has no view of cannot be read.
-  bool message_ok(int topic, const agnocast_entry& e, bool* read) {
+  bool message_ok(int topic, const agnocast_entry& e, bool* read, Message* seen = nullptr) {
     std::lock_guard<std::mutex> g(proc->mu);
     *read = false;
     auto it = proc->views.upper_bound(e.addr);
@@ -442,6 +443,7 @@ struct Worker {
     Message m;
     std::memcpy(&m, reinterpret_cast<const void*>(e.addr), sizeof(m));
     *read = true;
+    if (seen) *seen = m;
     return m.magic == kMagic && m.sum == checksum(m) && m.addr == e.addr &&
            static_cast<int>(m.topic) == topic && static_cast<int>(m.ns) == proc->ns &&
            m.publisher_id == e.publisher_id;
@@ -454,7 +456,8 @@ struct Worker {
   void verify(int topic, uint32_t handle, uint32_t sub_id, const agnocast_entry& e, bool recheck) {
     if (topic < 0) return;
     bool read;
-    if (message_ok(topic, e, &read)) {
+    Message m{};
+    if (message_ok(topic, e, &read, &m)) {
       if (read)
         (recheck ? sh->rechecked : sh->verified)++;
       else
@@ -463,10 +466,18 @@ struct Worker {
     }
     uint64_t id = e.entry_id;
     agnocast_release rel{handle, sub_id, uptr(&id), 1, 0};
-    if (call(AGNOCAST_IOC_RELEASE, &rel, handle, id) == 0)
+    if (call(AGNOCAST_IOC_RELEASE, &rel, handle, id) == 0) {
       fail(recheck ? "a held message changed before its release"
                    : "a received message is not one published on the subscriber's topic",
            e.entry_id, e.addr);
+      std::printf(
+          "fuzz: expected topic %d, namespace %d, publisher %u; the entry's memory holds: magic "
+          "%s, checksum %s, topic %u, namespace %u, publisher %u, pid %d, seq %llu, addr 0x%llx\n",
+          topic, proc->ns, e.publisher_id, m.magic == kMagic ? "ok" : "wrong",
+          m.sum == checksum(m) ? "ok" : "wrong", m.topic, m.ns, m.publisher_id, m.pid,
+          static_cast<unsigned long long>(m.seq), static_cast<unsigned long long>(m.addr));
+      std::fflush(stdout);
+    }
   }
 
   // Maps the pools a RECEIVE or TAKE handed over (a garbage step leaves some
@@ -1650,7 +1661,7 @@ int main(int argc, char** argv) {
   int seconds = -1, nprocs = 6;
   long long min_ops = -1;
   bool long_mode = std::getenv("AGNOCAST_FUZZ_LONG") != nullptr;
-  bool caps = false;
+  int caps_arg = -1;  // --caps 1, --no-caps 0, else by seed
   uint64_t base_seed = 0;
   bool seeded = false;
   int positional = 0;
@@ -1658,8 +1669,8 @@ int main(int argc, char** argv) {
     std::string a = argv[i];
     if (a == "--long") {
       long_mode = true;
-    } else if (a == "--caps") {
-      caps = true;
+    } else if (a == "--caps" || a == "--no-caps") {
+      caps_arg = a == "--caps";
     } else if (a == "--ops" && i + 1 < argc) {
       min_ops = std::atoll(argv[++i]);
     } else if (a == "--seed" && i + 1 < argc) {
@@ -1685,7 +1696,9 @@ int main(int argc, char** argv) {
       mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
   std::mt19937_64 rng(base_seed);
   bool ok = true;
-  if ((caps || base_seed % 3 == 0) && (caps || std::getenv("AGNOCAST_MODULE"))) {
+  bool caps =
+      caps_arg == 1 || (caps_arg < 0 && base_seed % 3 == 0 && std::getenv("AGNOCAST_MODULE"));
+  if (caps) {
     caps = reload_module(kSmallCaps);
     std::printf(
         "fuzz: %s: %s\n",
@@ -1896,6 +1909,6 @@ int main(int argc, char** argv) {
   if (!clean) ok = false;
   std::printf("fuzz: %s (seed %llu; replay: agnocast_fuzz_test %d %d --ops %lld --seed %llu%s)\n",
               ok ? "PASS" : "FAIL", static_cast<unsigned long long>(base_seed), seconds, nprocs,
-              min_ops, static_cast<unsigned long long>(base_seed), caps ? " --caps" : "");
+              min_ops, static_cast<unsigned long long>(base_seed), caps ? " --caps" : " --no-caps");
   return ok ? 0 : 1;
 }

@@ -8,10 +8,11 @@
 #
 # COMMAND's program is a target (its binary is copied into the VM) or a file
 # path (copied too); either is run by its file name from /opt/agnocast/bin,
-# which is on PATH.  TARGETS and FILES are further programs or data the test
-# needs, copied to the same place with every shared library they link.
-# OWN_FILES are copied likewise, but only into the boots that run this test
-# (large files, such as node, that no other kernel's boot should carry).
+# which is on PATH.  TARGETS (targets, also ones defined later) and FILES are
+# further programs or data the test needs, copied to the same place with every
+# shared library they link.  OWN_FILES are copied likewise, but only into the
+# boots that run this test (large files, such as node, that no other kernel's
+# boot should carry).
 # The VM runs each test as root in a fresh /tmp/vm-tests/<NAME> directory with
 # agnocast.ko freshly loaded with default parameters, default mqueue limits
 # and empty /dev/mqueue and /dev/shm (the module path is $AGNOCAST_MODULE),
@@ -30,8 +31,12 @@ function(agnocast_add_vm_test)
   endif()
 
   list(POP_FRONT arg_COMMAND program)
+  # TARGETS may name targets defined later (resolved when the build is generated).
   set(files)
-  foreach(item IN LISTS program arg_TARGETS arg_FILES)
+  foreach(item IN LISTS arg_TARGETS)
+    list(APPEND files "$<TARGET_FILE:${item}>")
+  endforeach()
+  foreach(item IN LISTS program arg_FILES)
     if(TARGET ${item})
       list(APPEND files "$<TARGET_FILE:${item}>")
     else()

@@ -23,6 +23,7 @@
 #include "agnocast/node.hpp"
 #include "agnocast/signals.hpp"
 #include "bag/bag.hpp"
+#include "standard_types.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -255,11 +256,17 @@ int bag_play(const BagPlayOptions& options, std::ostream& out) {
     } else if (channel.metadata.contains("agnocast_schema")) {
       played->type_hash = std::stoull(channel.metadata.at("agnocast_type_hash"), nullptr, 16);
       played->blob = from_hex(channel.metadata.at("agnocast_schema"));
+    } else if (const detail::MessageType* standard = standard_message_type(played->type_name)) {
+      // A file from another tool, of a standard type: laid out as the
+      // generated headers lay it out, which is what its subscribers expect.
+      played->type_hash = standard->hash;
+      played->blob.assign(standard->schema.begin(), standard->schema.end());
     }
     if (played->blob.empty()) {
       throw InputError(options.path + ": no layout known for topic '" + channel.topic + "' (" +
                        played->type_name +
-                       "): start a subscriber of it first, or record the file with agnocast");
+                       ", not a standard type): start a subscriber of it first, or record the "
+                       "file with agnocast");
     }
     try {
       played->schema = parse_schema(played->blob);

@@ -5,6 +5,7 @@
 
 #include <agnocast/detail/message.hpp>
 #include <agnocast/schema_cdr.hpp>
+#include <algorithm>
 #include <geometry_msgs/msg/transform_stamped.hpp>
 #include <memory>
 #include <sensor_msgs/msg/imu.hpp>
@@ -16,6 +17,7 @@
 
 #include "runtime.hpp"
 #include "standard_msg_texts.hpp"
+#include "standard_types.hpp"
 
 namespace {
 
@@ -178,6 +180,23 @@ TEST(SchemaCdr, StandardTypesKeepTheirConstantsAndComments) {
   EXPECT_EQ(text.rfind(std::string(*cloud), 0), 0U) << "the root's own text comes first";
   EXPECT_NE(text.find("\nMSG: std_msgs/Header\n"), std::string::npos);
   EXPECT_EQ(agnocast::standard_msg_text("robot/msg/Scan"), nullptr);
+}
+
+// bag play lays out a foreign file's standard types as the generated
+// headers do: the same name, hash and schema a compiled subscriber registers.
+TEST(SchemaCdr, StandardTypesAreKnownByNameAsTheirHeadersDeclareThem) {
+  const agnocast::detail::MessageType expected =
+      agnocast::detail::message_type_of<sensor_msgs::msg::PointCloud2>();
+  const agnocast::detail::MessageType* known =
+      agnocast::standard_message_type("sensor_msgs/msg/PointCloud2");
+  ASSERT_NE(known, nullptr);
+  EXPECT_EQ(known->name, expected.name);
+  EXPECT_EQ(known->hash, expected.hash);
+  EXPECT_TRUE(std::equal(known->schema.begin(), known->schema.end(), expected.schema.begin(),
+                         expected.schema.end()));
+  EXPECT_NE(agnocast::standard_message_type("geometry_msgs/msg/TransformStamped"), nullptr);
+  EXPECT_NE(agnocast::standard_message_type("tf2_msgs/msg/TFMessage"), nullptr);
+  EXPECT_EQ(agnocast::standard_message_type("robot/msg/Scan"), nullptr);
 }
 
 TEST(SchemaCdr, FieldNamesOfAMsgTextSkipConstantsAndComments) {

@@ -391,7 +391,7 @@ void print_markdown(const json& report) {
     const json& recording = report["recording"];
     std::printf(
         "\nRecording with `agnocast-cli bag record` (compression %s), the recorder's CPU time "
-        "(user + system, start and summary included) per recorded message:\n\n",
+        "(user + system, from its subscription to its exit) per recorded message:\n\n",
         recording.value("compression", std::string("zstd")).c_str());
     std::printf(
         "| recorded topic | published | in the file | lost | drops the recorder counted | "
@@ -550,10 +550,12 @@ boot; the mqueue hops are the floors' p50s of the same run.
 **Recording** (ordinary mode only: it is CPU time at a real rate) runs
 `agnocast-cli bag record` with its defaults (zstd, chunks of about 1 MiB) on
 one topic while one publisher sends a 4 MiB `sensor_msgs/PointCloud2` (x, y,
-z, intensity float32 points on a spiral) at 20 Hz for 5 s, then 64 B at
+z, intensity float32 points on a spiral) at 20 Hz for 2 s, then 64 B at
 1 kHz for 5 s; the recorder is stopped with SIGINT half a second after the
-last message. Its CPU time (user + system of the whole process, start-up and
-summary included) is divided by the messages in the file; "lost" is what was
+last message. Its CPU time (user + system) from its subscription to its exit
+(the last messages and the file's summary included, its start-up not) is
+divided by the messages in the file; under emulation it is several times
+what the same work costs natively. "lost" is what was
 published and is not in the file, "drops the recorder counted" what the
 kernel dropped for the recorder's subscription (it fell behind by more than
 its depth of 10).

@@ -10,6 +10,7 @@
 
 #include <agnocast/agnocast.hpp>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -358,12 +359,11 @@ TEST_F(BagLive, PlayedIntoFreshSubscribersByteEqualInOrderWithTheSpacing) {
 
 // std_msgs/msg/String as XCDR1: the header, the length with its NUL, the bytes.
 std::vector<std::uint8_t> string_cdr(const std::string& text) {
-  std::vector<std::uint8_t> out{0, 1, 0, 0};
   const auto length = static_cast<std::uint32_t>(text.size() + 1);
-  const auto* bytes = reinterpret_cast<const std::uint8_t*>(&length);
-  out.insert(out.end(), bytes, bytes + 4);
-  out.insert(out.end(), text.begin(), text.end());
-  out.push_back(0);
+  std::vector<std::uint8_t> out(4 + 4 + length, 0);
+  out[1] = 1;
+  std::memcpy(out.data() + 4, &length, sizeof length);
+  std::memcpy(out.data() + 8, text.data(), text.size());
   return out;
 }
 

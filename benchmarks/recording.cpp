@@ -266,7 +266,7 @@ json run_recording(const std::string& cli, bool smoke) {
   {
     constexpr std::size_t cloud_bytes = 4 << 20;
     constexpr double rate_hz = 20;
-    const std::size_t count = smoke ? 4 : 40;
+    const std::size_t count = smoke ? 2 : 40;
     const std::string topic = topic_name("cloud");
     Pipe report = Pipe::open(), stop = Pipe::open();
     using Cloud = sensor_msgs::msg::PointCloud2;

@@ -558,7 +558,15 @@ divided by the messages in the file; under emulation it is several times
 what the same work costs natively. "lost" is what was
 published and is not in the file, "drops the recorder counted" what the
 kernel dropped for the recorder's subscription (it fell behind by more than
-its depth of 10).
+its depth of 10). The recorder copies each message out as CDR, compresses
+1 MiB chunks with zstd and writes them from one thread: when the emulated
+vCPU it runs on gives it less CPU time per message than the rate leaves
+(50 ms at 20 Hz, 1 ms at 1 kHz, shared with the publisher and the other
+vCPU's work, on a host loaded as the table above says), it falls behind and
+the kernel drops its oldest messages for it alone, the publisher never
+waiting. Its CPU time per message here is emulated time; natively the same
+work is several times cheaper, so the losses say what this emulated machine
+sustains, not what a robot's computer does.
 
 The ordinary mode shares the host with whatever else runs there: the table
 above gives the host's load average before and after each mode. A load above
@@ -652,6 +660,11 @@ and host preemption of the vCPU threads on a loaded host (the load average
 above). Which of the two dominates, and why agnocast's window suffers it more
 than iceoryx's, has not been measured yet; until it is, the ordinary mode's
 64 MiB-written ratios are not evidence about real hardware either way.
+
+In the ordinary mode a QoS 1 subscriber on a loaded host loses messages (a
+newer one replaces the one it had not taken yet); each notification still
+wakes it once, so its calls per *delivered* message can exceed three, while
+icount, where nothing is lost, shows the calls per wake-up.
 
 A subscriber's system calls per message in steady state are the executor's
 `epoll_wait`, the notification taken (`mq_timedreceive`) and one RECEIVE

@@ -26,6 +26,7 @@
 #include "baselines.hpp"
 #include "bench_support.hpp"
 #include "iceoryx_runner.hpp"
+#include "recording.hpp"
 #include "report_shape.hpp"
 #include "round_estimate.hpp"
 
@@ -276,7 +277,8 @@ json cpu_json(const bench::CpuPerMessage& cpu) {
   return {{"publisher", cpu.publisher_us}, {"subscriber", cpu.subscriber_us}};
 }
 
-json run(const Plan& plan, const std::string& iceoryx_role, const std::string& breakdown_program) {
+json run(const Plan& plan, const std::string& iceoryx_role, const std::string& breakdown_program,
+         const std::string& cli) {
   json report;
   report["mode"] = plan.icount ? "icount" : "ordinary";
   report["machine"] = machine_json();
@@ -533,6 +535,19 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                           {"published", throughput.published},
                           {"received", throughput.received},
                           {"messages_per_s", throughput.messages_per_s}};
+
+  // Recording is CPU time and drops at a real rate: wall-time work, so only
+  // in the ordinary mode.
+  if (!plan.icount) {
+    std::cerr << "recording with agnocast-cli bag record...\n";
+    try {
+      report["recording"] = bench::run_recording(cli, plan.smoke);
+    } catch (const std::exception& error) {
+      // The rest of the report stands; the smoke's shape check fails on it.
+      std::cerr << "agnocast-bench: recording: " << error.what() << "\n";
+      report["recording"] = {{"error", error.what()}};
+    }
+  }
   return report;
 }
 
@@ -563,6 +578,7 @@ int main(int argc, char** argv) {
   const std::filesystem::path here = std::filesystem::read_symlink("/proc/self/exe").parent_path();
   std::string iceoryx_role = (here / "agnocast-bench-iceoryx").string();
   std::string breakdown_program = (here / "agnocast-bench-breakdown").string();
+  std::string cli = (here / "agnocast-cli").string();
   Plan plan;
   app.add_flag("--json", json_output, "print one JSON object instead of Markdown tables");
   app.add_flag("--smoke", smoke,
@@ -574,6 +590,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", plan.seed, "seed of the rounds' shuffled order");
   app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
   app.add_option("--breakdown-program", breakdown_program, "the cost breakdown program");
+  app.add_option("--cli", cli, "the agnocast-cli program, whose bag record is measured");
   app.add_flag("--icount", plan.icount,
                "the VM runs in QEMU's instruction-counting mode: fewer rounds, single-valued "
                "ratios, no series that needs parallel cores");
@@ -627,7 +644,7 @@ int main(int argc, char** argv) {
   if (smoke) plan.make_smoke();
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
   try {
-    json report = run(plan, iceoryx_role, breakdown_program);
+    json report = run(plan, iceoryx_role, breakdown_program, cli);
     if (json_output) {
       std::cout << report.dump() << "\n";
     } else {

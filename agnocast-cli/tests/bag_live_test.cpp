@@ -10,20 +10,24 @@
 
 #include <agnocast/agnocast.hpp>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sensor_msgs/msg/point_cloud2.hpp>
 #include <sstream>
+#include <std_msgs/msg/string.hpp>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "agnocast/inspect.hpp"
 #include "agnocast/mcap/reader.hpp"
+#include "agnocast/mcap/writer.hpp"
 
 namespace bag_live {
 
@@ -351,6 +355,126 @@ TEST_F(BagLive, PlayedIntoFreshSubscribersByteEqualInOrderWithTheSpacing) {
   EXPECT_EQ(wrong.code, 2) << wrong.err;
   EXPECT_NE(wrong.err.find("/bag_text"), std::string::npos) << wrong.err;
   EXPECT_NE(wrong.err.find("sensor_msgs/msg/PointCloud2"), std::string::npos) << wrong.err;
+}
+
+// std_msgs/msg/String as XCDR1: the header, the length with its NUL, the bytes.
+std::vector<std::uint8_t> string_cdr(const std::string& text) {
+  const auto length = static_cast<std::uint32_t>(text.size() + 1);
+  std::vector<std::uint8_t> out(4 + 4 + length, 0);
+  out[1] = 1;
+  std::memcpy(out.data() + 4, &length, sizeof length);
+  std::memcpy(out.data() + 8, text.data(), text.size());
+  return out;
+}
+
+// A file another tool wrote (no agnocast metadata), of a standard type, plays
+// with no subscriber running first: the type's layout is compiled into the
+// CLI. A compiled subscriber that joins later is accepted (same type hash)
+// and decodes what comes.
+TEST_F(BagLive, AForeignFileOfAStandardTypePlaysWithoutASubscriberFirst) {
+  {
+    agnocast::mcap::Writer writer("foreign.mcap",
+                                  {.profile = "ros2",
+                                   .library = "another tool",
+                                   .compression = agnocast::mcap::Compression::Zstd});
+    const std::string text = "string data\n";
+    const auto schema =
+        writer.add_schema("std_msgs/msg/String", "ros2msg", {text.begin(), text.end()});
+    const auto channel = writer.add_channel(schema, "/foreign_text", "cdr", {});
+    const std::uint64_t t0 = 1'700'000'000'000'000'000;
+    for (std::uint64_t i = 0; i < 40; ++i) {
+      writer.write_message(channel, t0 + i * 100'000'000, t0,
+                           string_cdr("message " + std::to_string(i)));
+    }
+    writer.close();
+  }
+  ASSERT_FALSE(agnocast::topic_info("/foreign_text"));
+  const pid_t player = ::fork();
+  if (player == 0) {
+    const int out = ::open("play.out", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open("play.err", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, STDOUT_FILENO);
+    ::dup2(err, STDERR_FILENO);
+    ::execlp("agnocast-cli", "agnocast-cli", "bag", "play", "foreign.mcap",
+             static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // The player's publisher appears, with the standard type.
+  std::optional<agnocast::TopicInfo> info;
+  for (int i = 0; i < 200 && !(info = agnocast::topic_info("/foreign_text")); ++i) {
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_TRUE(info) << slurp("play.err");
+  EXPECT_EQ(info->type_name, "std_msgs/msg/String");
+  agnocast::Node node("foreign_sink");
+  std::mutex lock;
+  std::vector<std::string> got;
+  auto subscription = node.create_subscription<std_msgs::msg::String>(
+      "/foreign_text", agnocast::QoS(100), [&](const std_msgs::msg::String& message) {
+        const std::lock_guard<std::mutex> guard(lock);
+        got.emplace_back(message.data.begin(), message.data.end());
+      });
+  agnocast::SingleThreadedExecutor executor;
+  executor.add_node(node);
+  std::thread spinner([&] { executor.spin(); });
+  const int code = wait_exit(player);
+  std::this_thread::sleep_for(300ms);
+  executor.cancel();
+  spinner.join();
+  ASSERT_EQ(code, 0) << slurp("play.err") << slurp("play.out");
+  const std::lock_guard<std::mutex> guard(lock);
+  // 40 messages over 3.9 s; the subscriber joined within the first second.
+  ASSERT_GE(got.size(), 25u) << slurp("play.out");
+  const std::string last = "message 39";
+  EXPECT_EQ(got.back(), last);
+  for (std::size_t i = 1; i < got.size(); ++i) {
+    EXPECT_EQ(std::stoi(got[i].substr(8)), std::stoi(got[i - 1].substr(8)) + 1) << got[i];
+  }
+}
+
+// Hostile files: bag play names the file and exits 2 for one it cannot open,
+// and plays what a damaged one holds, saying where it stops.
+TEST_F(BagLive, HostileFilesAreNamedNeverACrash) {
+  {
+    agnocast::mcap::Writer writer("hostile.mcap", {.profile = "ros2", .chunk_size = 256});
+    const std::string text = "string data\n";
+    const auto schema =
+        writer.add_schema("std_msgs/msg/String", "ros2msg", {text.begin(), text.end()});
+    const auto channel = writer.add_channel(schema, "/hostile_text", "cdr", {});
+    for (std::uint64_t i = 0; i < 40; ++i) {
+      writer.write_message(channel, 1000 + i, 1000, string_cdr("message " + std::to_string(i)));
+    }
+    writer.close();
+  }
+  auto patch = [](const char* path, std::uint64_t offset, auto value) {
+    std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(static_cast<std::streamoff>(offset));
+    file.write(reinterpret_cast<const char*>(&value), sizeof value);
+  };
+  fs::copy_file("hostile.mcap", "header.mcap", fs::copy_options::overwrite_existing);
+  patch("header.mcap", 9, std::uint64_t{1} << 62);  // the Header's length
+  Outcome r = cli("bag play header.mcap");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("header.mcap"), std::string::npos) << r.err;
+  r = cli("bag info header.mcap");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("header.mcap"), std::string::npos) << r.err;
+
+  // The third chunk declares 2^60 bytes: the two before it play.
+  std::uint64_t third = 0;
+  {
+    const agnocast::mcap::Reader reader("hostile.mcap");
+    ASSERT_TRUE(reader.summary());
+    ASSERT_GE(reader.summary()->chunk_indexes.size(), 4u);
+    third = reader.summary()->chunk_indexes[2].chunk_start_offset;
+  }
+  fs::copy_file("hostile.mcap", "chunk.mcap", fs::copy_options::overwrite_existing);
+  patch("chunk.mcap", third + 9 + 16, std::uint64_t{1} << 60);
+  r = cli("bag play chunk.mcap --rate 1000");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("chunk.mcap ends early"), std::string::npos) << r.out;
+  r = cli("bag info chunk.mcap --json");
+  EXPECT_EQ(r.code, 0) << r.err;
 }
 
 TEST_F(BagLive, BadInputIsExitTwoNamingIt) {

@@ -15,6 +15,7 @@
 #include "agnocast/mcap/writer.hpp"
 #include "bag/bag.hpp"
 #include "runtime.hpp"
+#include "standard_msg_texts.hpp"
 
 namespace bag_sample {
 
@@ -50,7 +51,7 @@ class SampleFile {
   template <class T>
   std::uint16_t topic(const std::string& name) {
     const agnocast::Schema schema = agnocast::parse_schema(agnocast::schema_of<T>());
-    const std::string text = agnocast::ros2msg_definition(schema);
+    const std::string text = agnocast::ros2msg_definition(schema, agnocast::standard_msg_text);
     const auto schema_id =
         writer_.add_schema(schema.types[0].name, "ros2msg", {text.begin(), text.end()});
     return writer_.add_channel(

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <deque>
 #include <exception>
@@ -81,6 +82,9 @@ struct Executor::State {
 
   ~State() {
     for (const auto& node : nodes) node->remove_watcher(change_fd);
+    for (const auto& weak : timed) {
+      if (const auto waitable = weak.lock()) waitable->watch_deadline(false);
+    }
     ::close(epoll_fd);
     ::close(cancel_fd);
     ::close(change_fd);
@@ -92,13 +96,45 @@ struct Executor::State {
     std::lock_guard lock(mutex);
     drain_eventfd(change_fd);
     std::erase_if(armed, [](const auto& entry) { return entry.second.expired(); });
+    std::erase_if(timed, [](const auto& weak) { return weak.expired(); });
     for (const auto& node : nodes) {
       for (const auto& weak : node->waitables_snapshot()) {
         const auto waitable = weak.lock();
         if (!waitable || armed.contains(waitable->key())) continue;
         watch(epoll_fd, waitable->wait_fd(), waitable->key(), waitable_events, EPOLL_CTL_ADD);
         armed.emplace(waitable->key(), weak);
+        if (waitable->watch_deadline(true)) timed.push_back(weak);
       }
+    }
+  }
+
+  // The waitable no longer watched, with mutex held.
+  void unwatch(const std::shared_ptr<detail::Waitable>& waitable) {
+    const auto found = std::find_if(timed.begin(), timed.end(), [&](const auto& weak) {
+      return !weak.owner_before(waitable) && !waitable.owner_before(weak);
+    });
+    if (found == timed.end()) return;
+    timed.erase(found);
+    waitable->watch_deadline(false);
+  }
+
+  // The earliest deadline of the watched waitables (max(): none).
+  detail::Waitable::Clock::time_point earliest_deadline() {
+    auto earliest = detail::Waitable::Clock::time_point::max();
+    std::lock_guard lock(mutex);
+    for (const auto& weak : timed) {
+      if (const auto waitable = weak.lock()) earliest = std::min(earliest, waitable->deadline());
+    }
+    return earliest;
+  }
+
+  // Runs the work of every watched waitable whose deadline has passed.
+  void expire_due() {
+    const auto now = detail::Waitable::Clock::now();
+    std::lock_guard lock(mutex);
+    for (const auto& weak : timed) {
+      const auto waitable = weak.lock();
+      if (waitable && waitable->deadline() <= now) waitable->expire();
     }
   }
 
@@ -121,15 +157,35 @@ struct Executor::State {
     return housekeeping ? Outcome::idle : Outcome::handled;
   }
 
+  // Waits at most timeout_ms (-1: no limit) and at most until the earliest
+  // deadline, then handles what is ready and, when the wait reached a
+  // deadline, the deadlines due: no timer descriptor, no extra system call.
   Outcome wait_and_handle(int timeout_ms) {
+    bool deadline_bound = false;
+    if (const auto earliest = earliest_deadline();
+        earliest != detail::Waitable::Clock::time_point::max()) {
+      // Rounded up: the wait must not end before the deadline.
+      const auto left =
+          std::chrono::ceil<std::chrono::milliseconds>(earliest - detail::Waitable::Clock::now());
+      const int left_ms = static_cast<int>(std::clamp<std::int64_t>(left.count(), 0, 1 << 30));
+      if (timeout_ms < 0 || left_ms <= timeout_ms) {
+        timeout_ms = left_ms;
+        deadline_bound = true;
+      }
+    }
     epoll_event event{};
     const int ready = ::epoll_wait(epoll_fd, &event, 1, timeout_ms);
     if (ready < 0) {
       if (errno == EINTR) return Outcome::idle;
       throw Error(std::string("agnocast: epoll_wait: ") + std::strerror(errno));
     }
-    if (ready == 0) return Outcome::idle;
-    return handle(event.data.u64);
+    const Outcome outcome = ready == 0 ? Outcome::idle : handle(event.data.u64);
+    // An event before the deadline (timeout > 0) leaves the deadline for a
+    // later wait; one that came with a deadline already due does not delay it.
+    if (deadline_bound && (ready == 0 || timeout_ms == 0) && outcome != Outcome::stop) {
+      expire_due();
+    }
+    return outcome;
   }
 
   const std::uint32_t waitable_events;
@@ -140,6 +196,8 @@ struct Executor::State {
   std::vector<std::shared_ptr<detail::NodeState>> nodes;
   std::map<std::uint64_t, std::weak_ptr<detail::Waitable>> armed;
   std::map<int, std::shared_ptr<FdWaitable>> fds;  // what add_fd() added, by descriptor
+  // Armed waitables whose deadlines this executor watches (Waitable::deadline).
+  std::vector<std::weak_ptr<detail::Waitable>> timed;
 };
 
 namespace {
@@ -228,6 +286,7 @@ void Executor::remove_node(Node& node) {
     const auto waitable = weak.lock();
     if (!waitable || !state_->armed.erase(waitable->key())) continue;
     ::epoll_ctl(state_->epoll_fd, EPOLL_CTL_DEL, waitable->wait_fd(), nullptr);
+    state_->unwatch(waitable);
   }
 }
 
@@ -267,6 +326,9 @@ void Executor::spin_some() {
   const int ready = ::epoll_wait(state_->epoll_fd, events, 64, 0);
   for (int i = 0; i < ready; ++i) {
     if (state_->handle(events[i].data.u64) == State::Outcome::stop) return;
+  }
+  if (state_->earliest_deadline() != detail::Waitable::Clock::time_point::max()) {
+    state_->expire_due();
   }
 }
 

@@ -1,5 +1,6 @@
 #include "agnocast/schema_cdr.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 namespace agnocast {
@@ -250,16 +251,69 @@ std::string ros2msg_type_name(std::string_view type_name) {
   return std::string(type_name.substr(0, slash)) + "/" + std::string(type_name.substr(slash + 5));
 }
 
-std::string ros2msg_definition(const Schema& schema) {
+std::string ros2msg_definition(const Schema& schema) { return ros2msg_definition(schema, {}); }
+
+std::vector<std::string> msg_text_field_names(std::string_view text) {
+  std::vector<std::string> names;
+  while (!text.empty()) {
+    const std::size_t end = text.find('\n');
+    std::string_view line = text.substr(0, end);
+    text = end == std::string_view::npos ? std::string_view{} : text.substr(end + 1);
+    if (const std::size_t comment = line.find('#'); comment != std::string_view::npos) {
+      line = line.substr(0, comment);
+    }
+    std::vector<std::string_view> tokens;
+    for (std::size_t at = 0; at < line.size();) {
+      const std::size_t start = line.find_first_not_of(" \t\r", at);
+      if (start == std::string_view::npos) break;
+      const std::size_t stop = std::min(line.find_first_of(" \t\r", start), line.size());
+      tokens.push_back(line.substr(start, stop - start));
+      at = stop;
+    }
+    if (tokens.size() < 2) continue;
+    // "TYPE NAME=VALUE" or "TYPE NAME = VALUE": a constant ("<=" is a bound, in the type).
+    if (tokens[1].find('=') != std::string_view::npos) continue;
+    if (tokens.size() > 2 && tokens[2].front() == '=') continue;
+    names.emplace_back(tokens[1]);
+  }
+  return names;
+}
+
+namespace {
+
+// The type's own .msg text when text_of knows it and its fields are the
+// schema's; else its fields written from the schema.
+std::string type_text(const Schema& schema, const SchemaType& type, const MsgTextLookup& text_of) {
+  if (text_of) {
+    if (const std::string_view* known = text_of(type.name)) {
+      const std::vector<std::string> names = msg_text_field_names(*known);
+      const bool same = names.size() == type.fields.size() &&
+                        std::equal(names.begin(), names.end(), type.fields.begin(),
+                                   [](const std::string& name, const SchemaField& field) {
+                                     return name == field.name;
+                                   });
+      if (same && !known->empty()) {
+        std::string text(*known);
+        if (text.back() != '\n') text += '\n';
+        return text;
+      }
+    }
+  }
+  return type_fields(schema, type);
+}
+
+}  // namespace
+
+std::string ros2msg_definition(const Schema& schema, const MsgTextLookup& text_of) {
   const SchemaType& root = schema.types.at(0);
-  std::string text = type_fields(schema, root);
+  std::string text = type_text(schema, root, text_of);
   std::vector<bool> seen(schema.types.size(), false);
   std::vector<std::uint16_t> order;
   collect_dependencies(schema, root, seen, order);
   for (const std::uint16_t index : order) {
     text += std::string(80, '=');
     text += "\nMSG: " + ros2msg_type_name(schema.types[index].name) + "\n";
-    text += type_fields(schema, schema.types[index]);
+    text += type_text(schema, schema.types[index], text_of);
   }
   return text;
 }

@@ -41,9 +41,10 @@ timespec to_timespec(std::chrono::nanoseconds duration) {
 // message is still held, so that memory is never reclaimed under a reader.
 // A callback subscriber's releases made while it handles a wake-up (messages
 // dropped by its callbacks) ride on its next receive: of that wake-up, or of
-// the next one.  What a wake-up leaves waits at most deferred_release_delay:
-// a one-shot timer in the executor's epoll set, armed only while releases
-// wait, then releases it in one call (see ReleaseTimer).  A full batch, what
+// the next one.  What a wake-up leaves waits at most deferred_release_delay,
+// then goes in one call (see ReleaseTimer): in an executor, the deadline is
+// its wait's timeout, which costs no system call; else a one-shot timerfd,
+// armed only while releases wait, is the owner's to watch.  A full batch, what
 // a throwing callback's wake-up leaves, and any release outside a wake-up go
 // at once.
 class SubscriberEndpoint : public EntryOwner {
@@ -115,12 +116,36 @@ class SubscriberEndpoint : public EntryOwner {
     if (!still_ours()) return;
     std::lock_guard lock(release_mutex_);
     timer_armed_ = false;
+    deadline_.store(no_deadline, std::memory_order_relaxed);
     if (pending_count_ > 0 && !handling_wakeup_) release_pending();
+  }
+
+  // An executor watches the deadline of what waits (watched), or stops to.
+  // With none left, the timerfd bounds the wait again; what waits when the
+  // last one stops goes now.
+  void watch_deadline(bool watched) noexcept {
+    if (!still_ours()) return;
+    std::lock_guard lock(release_mutex_);
+    if (watched) {
+      ++deadline_watchers_;
+      return;
+    }
+    if (deadline_watchers_ > 0 && --deadline_watchers_ == 0) {
+      deadline_.store(no_deadline, std::memory_order_relaxed);
+      if (pending_count_ > 0 && !handling_wakeup_) release_pending();
+    }
+  }
+
+  // When what waits must go, for the executors that watch it.
+  Waitable::Clock::time_point deadline() const noexcept {
+    return Waitable::Clock::time_point(
+        Waitable::Clock::duration(deadline_.load(std::memory_order_relaxed)));
   }
 
   // Moves the releases waiting for the next receive into batch; returns their number.
   std::size_t take_releases(ReleaseBatch& batch) {
     std::lock_guard lock(release_mutex_);
+    deadline_.store(no_deadline, std::memory_order_relaxed);
     const std::size_t count = std::exchange(pending_count_, 0);
     std::copy_n(pending_releases_.begin(), count, batch.begin());
     return count;
@@ -170,6 +195,13 @@ class SubscriberEndpoint : public EntryOwner {
 
   // With release_mutex_ held. False when there is no timer to wait for.
   bool arm_deferred_release() noexcept {
+    if (deadline_watchers_ > 0) {
+      if (deadline_.load(std::memory_order_relaxed) == no_deadline) {
+        const auto due = Waitable::Clock::now() + deferred_release_delay;
+        deadline_.store(due.time_since_epoch().count(), std::memory_order_relaxed);
+      }
+      return true;
+    }
     if (timer_fd_ < 0) return false;
     if (timer_armed_) return true;  // it expires soon enough already
     const itimerspec once{timespec{}, to_timespec(deferred_release_delay)};
@@ -180,6 +212,7 @@ class SubscriberEndpoint : public EntryOwner {
 
   // With release_mutex_ held.
   void release_pending() noexcept {
+    deadline_.store(no_deadline, std::memory_order_relaxed);
     try {
       runtime_.kernel().release(id_, std::span(pending_releases_.data(), pending_count_));
     } catch (const Error& error) {
@@ -198,14 +231,20 @@ class SubscriberEndpoint : public EntryOwner {
   bool handling_wakeup_ = false;
   int timer_fd_ = -1;
   bool timer_armed_ = false;
+  static constexpr Waitable::Clock::rep no_deadline =
+      Waitable::Clock::time_point::max().time_since_epoch().count();
+  int deadline_watchers_ = 0;  // executors watching deadline_
+  std::atomic<Waitable::Clock::rep> deadline_{no_deadline};
   ReleaseBatch pending_releases_{};
   std::size_t pending_count_ = 0;
   std::mutex spare_mutex_;  // releases come from any thread
   std::vector<EntryReference*> spare_references_;
 };
 
-// The deferred release's one-shot timer, in the executor's epoll set beside
-// its subscription.  Its expiry is housekeeping: spin_once() does not count it.
+// The deferred release's deadline, in the executor's set beside its
+// subscription: the executor's wait times out at it (see Waitable::deadline).
+// Its one-shot timerfd is armed only when no executor watches the deadline.
+// Its expiry is housekeeping: spin_once() does not count it.
 class ReleaseTimer : public Waitable {
  public:
   ReleaseTimer(std::shared_ptr<CallbackGroup> group, std::shared_ptr<SubscriberEndpoint> endpoint)
@@ -218,6 +257,12 @@ class ReleaseTimer : public Waitable {
 
   int wait_fd() const override { return fd_; }
   bool housekeeping() const override { return true; }
+  bool watch_deadline(bool watched) override {
+    endpoint_->watch_deadline(watched);
+    return true;
+  }
+  Clock::time_point deadline() const override { return endpoint_->deadline(); }
+  void expire() override { endpoint_->release_deferred(); }
   void execute() override {
     std::uint64_t expirations = 0;
     if (::read(fd_, &expirations, sizeof expirations) != sizeof expirations) return;

@@ -3,8 +3,14 @@
 #include <gtest/gtest.h>
 #include <mqueue.h>
 #include <poll.h>
+#include <signal.h>
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
+#include <sys/syscall.h>
+#include <sys/timerfd.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <stdexcept>
@@ -14,6 +20,24 @@
 #include "agnocast/executor.hpp"
 #include "agnocast/node.hpp"
 #include "fake_runtime.hpp"
+
+// The executor's waits and the timers armed, counted: libagnocast calls
+// these through the C library, which this program's definitions replace.
+namespace agnocast::detail::counted_calls {
+std::atomic<int> epoll_waits{0};
+std::atomic<int> timer_settings{0};
+}  // namespace agnocast::detail::counted_calls
+
+extern "C" int epoll_wait(int epoll_fd, epoll_event* events, int capacity, int timeout_ms) {
+  ++agnocast::detail::counted_calls::epoll_waits;
+  return static_cast<int>(
+      syscall(SYS_epoll_pwait, epoll_fd, events, capacity, timeout_ms, nullptr, _NSIG / 8));
+}
+
+extern "C" int timerfd_settime(int fd, int flags, const itimerspec* value, itimerspec* old) {
+  ++agnocast::detail::counted_calls::timer_settings;
+  return static_cast<int>(syscall(SYS_timerfd_settime, fd, flags, value, old));
+}
 
 namespace agnocast::detail {
 namespace {
@@ -122,6 +146,97 @@ TEST_F(SubscriptionTest, SteadyStateSystemCallsPerMessageAtDepthOneAndTen) {
     EXPECT_EQ(kernel().calls().release - after.release, 1) << "depth " << depth;
     EXPECT_EQ(kernel().calls().released_entries - before.released_entries, messages);
   }
+}
+
+// The same steady state driven by an executor, every system call counted:
+// per message the executor's one wait, one notification taken and one
+// RECEIVE carrying the previous message's release — three — at depth 1 and
+// 10.  The deferred release's deadline is the wait's timeout: no timer is
+// set or read, and when nothing more arrives the last message goes back
+// within the bound, in one RELEASE.
+TEST_F(SubscriptionTest, InAnExecutorEachMessageCostsThreeSystemCallsAtDepthOneAndTen) {
+  using counted_calls::epoll_waits;
+  using counted_calls::timer_settings;
+  for (const std::uint32_t depth : {1U, 10U}) {
+    Node node{"executor_calls"};
+    const std::string name = topic("executor_calls" + std::to_string(depth));
+    int count = 0;
+    auto subscription = node.create_subscription<Counted>(
+        name, QoS{depth}, [&](const ipc_shared_ptr<const Counted>&) { ++count; });
+    auto publisher = node.create_publisher<Counted>(name, QoS{depth});
+    SingleThreadedExecutor executor;
+    executor.add_node(node);
+    ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(1000)));  // its own notification
+    publish(*publisher, 0);  // one message before: its release is waiting from then on
+    ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(1000)));
+
+    constexpr int messages = 20;
+    int notifications_taken = 0;
+    const FakeKernel::Calls before = kernel().calls();
+    const int waits_before = epoll_waits.load();
+    const int timers_before = timer_settings.load();
+    for (int i = 1; i <= messages; ++i) {
+      publish(*publisher, static_cast<std::uint64_t>(i));
+      const long waiting = queued(subscription->queue_fd());
+      ASSERT_EQ(waiting, 1) << "depth " << depth;
+      ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(1000)));
+      notifications_taken += static_cast<int>(waiting - queued(subscription->queue_fd()));
+    }
+    const FakeKernel::Calls after = kernel().calls();
+    EXPECT_EQ(count, messages + 1);
+    const int kernel_calls = (after.receive - before.receive) + (after.release - before.release) +
+                             (after.take - before.take) + (after.reclaim - before.reclaim) +
+                             (after.shed - before.shed);
+    const int waits = epoll_waits.load() - waits_before;
+    EXPECT_EQ(waits, messages) << "depth " << depth;
+    EXPECT_EQ(kernel_calls, messages) << "depth " << depth;
+    EXPECT_EQ(notifications_taken, messages) << "depth " << depth;
+    EXPECT_EQ(timer_settings.load() - timers_before, 0) << "depth " << depth;
+    EXPECT_LE(waits + kernel_calls + notifications_taken, 3 * messages) << "depth " << depth;
+    EXPECT_EQ(after.released_entries - before.released_entries, messages) << "depth " << depth;
+
+    // Nothing more: the wait times out at the deadline and releases the last one.
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_FALSE(executor.spin_once(std::chrono::milliseconds(200)));
+    TopicInfo info;
+    ASSERT_TRUE(kernel().topic_info(name, info));
+    EXPECT_EQ(info.subscribers.at(0).held, 0U) << "depth " << depth;
+    EXPECT_EQ(kernel().calls().release - after.release, 1) << "depth " << depth;
+    EXPECT_EQ(timer_settings.load() - timers_before, 0) << "depth " << depth;
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(1000));
+  }
+}
+
+// The deadline is kept while the executor runs other work: a wait that
+// other descriptors keep ending still releases in time.
+TEST_F(SubscriptionTest, TheDeferredReleaseIsNotStarvedByOtherWork) {
+  Node node{"starved"};
+  const std::string name = topic("starved");
+  auto subscription =
+      node.create_subscription<Counted>(name, QoS{10}, [](const ipc_shared_ptr<const Counted>&) {});
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  SingleThreadedExecutor executor;
+  executor.add_node(node);
+  ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(1000)));
+  publish(*publisher, 1);
+  ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(1000)));
+  TopicInfo info;
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  ASSERT_EQ(info.subscribers.at(0).held, 1U);
+  // A descriptor always readable: every wait ends at once with its event.
+  const int busy = ::eventfd(1, EFD_CLOEXEC);
+  ASSERT_GE(busy, 0);
+  int handled = 0;
+  executor.add_fd(busy, [&] { ++handled; });
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(100)) {
+    ASSERT_TRUE(executor.spin_once(std::chrono::milliseconds(100)));
+  }
+  executor.remove_fd(busy);
+  ::close(busy);
+  EXPECT_GT(handled, 0);
+  ASSERT_TRUE(kernel().topic_info(name, info));
+  EXPECT_EQ(info.subscribers.at(0).held, 0U);
 }
 
 // The notification that woke a subscriber is taken after its callbacks: a

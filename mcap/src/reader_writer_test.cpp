@@ -4,6 +4,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <optional>
 
 #include "agnocast/mcap/reader.hpp"
 #include "agnocast/mcap/writer.hpp"
@@ -224,6 +226,74 @@ TEST_P(McapFile, ADamagedSummaryIsNoSummary) {
   ScanResult result;
   EXPECT_EQ(read_messages(reader, result).size(), 60u);
   EXPECT_TRUE(result.reached_data_end);
+}
+
+// Patches `bytes` at `offset` of the file with `value`'s bytes.
+template <class T>
+void patch(const std::string& path, std::uint64_t offset, T value) {
+  std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+  file.seekp(static_cast<std::streamoff>(offset));
+  file.write(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+// Hostile files: every lie is a FormatError or a scan that stops and says
+// why, never a crash, a read past the end or an allocation of a declared size.
+TEST_P(McapFile, HostileLengthsSizesOpcodesAndCrcsStopTheScanCleanly) {
+  std::vector<Written> written;
+  const std::string original = write_sample(written, 1 << 20);  // one chunk
+  ChunkIndex index;
+  std::uint64_t summary_start = 0;
+  {
+    const Reader reader(original);
+    ASSERT_TRUE(reader.summary());
+    index = reader.summary()->chunk_indexes.at(0);
+    summary_start = reader.summary()->footer.summary_start;
+  }
+  const std::uint64_t chunk = index.chunk_start_offset;
+  // Chunk content: start and end times, then uncompressed_size, then its CRC.
+  const std::uint64_t uncompressed_size_at = chunk + 9 + 16;
+  const std::uint64_t uncompressed_crc_at = uncompressed_size_at + 8;
+  const std::string path = (dir_ / "hostile.mcap").string();
+  struct Case {
+    const char* what;
+    std::function<void()> damage;
+  };
+  const std::vector<Case> cases{
+      {"a record length of 2^63", [&] { patch(path, chunk + 1, std::uint64_t{1} << 63); }},
+      {"a record length one byte past the end",
+       [&] { patch(path, chunk + 1, fs::file_size(path) - chunk - 9 + 1); }},
+      {"a chunk declaring 2^60 uncompressed bytes",
+       [&] { patch(path, uncompressed_size_at, std::uint64_t{1} << 60); }},
+      {"a chunk declaring one byte more than it holds",
+       [&] { patch(path, uncompressed_size_at, index.uncompressed_size + 1); }},
+      {"a chunk declaring one byte less than it holds",
+       [&] { patch(path, uncompressed_size_at, index.uncompressed_size - 1); }},
+      {"a chunk's CRC wrong", [&] { patch(path, uncompressed_crc_at, std::uint32_t{0xDEADBEEF}); }},
+      {"an unknown opcode instead of a chunk's", [&] { patch(path, chunk, std::uint8_t{0x7F}); }},
+      {"a Footer's opcode instead of a chunk's",
+       [&] { patch(path, chunk, static_cast<std::uint8_t>(Opcode::Footer)); }},
+      {"a summary offset past the end",
+       [&] { patch(path, fs::file_size(path) - magic.size() - 20, ~std::uint64_t{0} >> 1); }},
+      {"a summary record length of 2^62",
+       [&] { patch(path, summary_start + 1, std::uint64_t{1} << 62); }},
+  };
+  for (const Case& hostile : cases) {
+    SCOPED_TRACE(hostile.what);
+    fs::copy_file(original, path, fs::copy_options::overwrite_existing);
+    hostile.damage();
+    std::optional<Reader> reader;
+    try {
+      reader.emplace(path);
+    } catch (const FormatError& error) {
+      EXPECT_NE(std::string(error.what()).find(path), std::string::npos) << error.what();
+      continue;
+    }
+    ScanResult result;
+    const auto read = read_messages(*reader, result);
+    EXPECT_EQ(result.reached_data_end, result.stopped.empty()) << result.stopped;
+    ASSERT_LE(read.size(), written.size());
+    for (std::size_t i = 0; i < read.size(); ++i) EXPECT_EQ(read[i].data, written[i].data);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(All, McapFile,

@@ -478,6 +478,123 @@ std::vector<std::uint8_t> compress(Compression compression, std::span<const std:
   return out;
 }
 
+namespace {
+
+// The output of a decompression, grown only as the codec really produces
+// bytes: a declared size is a claim, never an allocation (a few bytes that
+// declare terabytes cost what they decompress to, then a FormatError).
+class GrowingOutput {
+ public:
+  GrowingOutput(std::uint64_t declared, std::size_t input_size) : declared_(declared) {
+    const std::uint64_t first = std::min<std::uint64_t>(
+        declared, std::max<std::uint64_t>(std::uint64_t{64} << 10, std::uint64_t{4} * input_size));
+    out_.resize(static_cast<std::size_t>(first));
+  }
+  // Room after `written` bytes; grows (at most to the declared size) when full.
+  std::span<std::uint8_t> room(std::size_t written) {
+    if (written == out_.size() && out_.size() < declared_) {
+      out_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(declared_, 2 * out_.size())));
+    }
+    return std::span(out_).subspan(written);
+  }
+  bool full(std::size_t written) const { return written == declared_; }
+  std::vector<std::uint8_t> take(std::size_t written) {
+    out_.resize(written);
+    return std::move(out_);
+  }
+
+ private:
+  const std::uint64_t declared_;
+  std::vector<std::uint8_t> out_;
+};
+
+[[noreturn]] void shorter(const char* codec, std::size_t written, std::uint64_t declared) {
+  throw FormatError(std::string("mcap: ") + codec + " chunk decompresses to " +
+                    std::to_string(written) + " bytes, not the " + std::to_string(declared) +
+                    " it declares");
+}
+
+std::vector<std::uint8_t> decompress_zstd(std::span<const std::uint8_t> bytes,
+                                          std::uint64_t declared) {
+  const std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> context(ZSTD_createDCtx(),
+                                                                     &ZSTD_freeDCtx);
+  if (!context) throw FormatError("mcap: no zstd decompression context");
+  GrowingOutput output(declared, bytes.size());
+  ZSTD_inBuffer in{bytes.data(), bytes.size(), 0};
+  std::size_t written = 0;
+  for (;;) {
+    const std::span<std::uint8_t> room = output.room(written);
+    ZSTD_outBuffer out{room.data(), room.size(), 0};
+    std::size_t hint = ZSTD_decompressStream(context.get(), &out, &in);
+    if (ZSTD_isError(hint)) {
+      throw FormatError(std::string("mcap: zstd chunk does not decompress: ") +
+                        ZSTD_getErrorName(hint));
+    }
+    written += out.pos;
+    if (in.pos == in.size && out.pos < out.size) break;  // all input used, all output out
+    if (output.full(written)) {
+      // What is left of the input must not decompress to a single byte more.
+      while (hint != 0 || in.pos < in.size) {
+        std::uint8_t extra = 0;
+        ZSTD_outBuffer probe{&extra, 1, 0};
+        const std::size_t consumed_before = in.pos;
+        hint = ZSTD_decompressStream(context.get(), &probe, &in);
+        if (ZSTD_isError(hint)) {
+          throw FormatError(std::string("mcap: zstd chunk does not decompress: ") +
+                            ZSTD_getErrorName(hint));
+        }
+        if (probe.pos > 0) {
+          throw FormatError("mcap: zstd chunk decompresses to more than the " +
+                            std::to_string(declared) + " bytes it declares");
+        }
+        if (in.pos == consumed_before) break;  // no progress: the input ends inside the frame
+      }
+      break;
+    }
+  }
+  if (!output.full(written)) shorter("zstd", written, declared);
+  return output.take(written);
+}
+
+std::vector<std::uint8_t> decompress_lz4(std::span<const std::uint8_t> bytes,
+                                         std::uint64_t declared) {
+  LZ4F_dctx* raw = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
+    throw FormatError("mcap: no lz4 decompression context");
+  }
+  const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> context(
+      raw, &LZ4F_freeDecompressionContext);
+  GrowingOutput output(declared, bytes.size());
+  std::size_t written = 0;
+  std::size_t read = 0;
+  for (;;) {
+    const std::span<std::uint8_t> room = output.room(written);
+    // Once the declared size is reached, a byte of room: any output in it is too much.
+    std::uint8_t extra = 0;
+    const bool probing = output.full(written);
+    std::size_t out_size = probing ? 1 : room.size();
+    std::size_t in_size = bytes.size() - read;
+    const std::size_t hint = LZ4F_decompress(context.get(), probing ? &extra : room.data(),
+                                             &out_size, bytes.data() + read, &in_size, nullptr);
+    if (LZ4F_isError(hint)) {
+      throw FormatError(std::string("mcap: lz4 chunk does not decompress: ") +
+                        LZ4F_getErrorName(hint));
+    }
+    if (probing && out_size > 0) {
+      throw FormatError("mcap: lz4 chunk decompresses to more than the " +
+                        std::to_string(declared) + " bytes it declares");
+    }
+    written += probing ? 0 : out_size;
+    read += in_size;
+    if (hint == 0) break;                      // the frame is complete
+    if (in_size == 0 && out_size == 0) break;  // no progress: the input ends inside the frame
+  }
+  if (!output.full(written)) shorter("lz4", written, declared);
+  return output.take(written);
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> decompress(std::string_view compression,
                                      std::span<const std::uint8_t> bytes,
                                      std::uint64_t uncompressed_size) {
@@ -487,48 +604,8 @@ std::vector<std::uint8_t> decompress(std::string_view compression,
     }
     return {bytes.begin(), bytes.end()};
   }
-  // A declared size far beyond what the codec can expand the input to is a lie, not an
-  // allocation (zstd and lz4 expand at most ~255x per input byte... give them room).
-  if (uncompressed_size / 1024 > bytes.size() + 1024) {
-    throw FormatError("mcap: a chunk declares " + std::to_string(uncompressed_size) +
-                      " uncompressed bytes from only " + std::to_string(bytes.size()));
-  }
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(uncompressed_size));
-  if (compression == "zstd") {
-    const std::size_t size = ZSTD_decompress(out.data(), out.size(), bytes.data(), bytes.size());
-    if (ZSTD_isError(size)) {
-      throw FormatError(std::string("mcap: zstd chunk does not decompress: ") +
-                        ZSTD_getErrorName(size));
-    }
-    if (size != out.size()) throw FormatError("mcap: zstd chunk is shorter than declared");
-    return out;
-  }
-  if (compression == "lz4") {
-    LZ4F_dctx* raw = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&raw, LZ4F_VERSION))) {
-      throw FormatError("mcap: no lz4 decompression context");
-    }
-    const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> context(
-        raw, &LZ4F_freeDecompressionContext);
-    std::size_t written = 0;
-    std::size_t read = 0;
-    while (read < bytes.size()) {
-      std::size_t out_size = out.size() - written;
-      std::size_t in_size = bytes.size() - read;
-      const std::size_t hint = LZ4F_decompress(context.get(), out.data() + written, &out_size,
-                                               bytes.data() + read, &in_size, nullptr);
-      if (LZ4F_isError(hint)) {
-        throw FormatError(std::string("mcap: lz4 chunk does not decompress: ") +
-                          LZ4F_getErrorName(hint));
-      }
-      written += out_size;
-      read += in_size;
-      if (hint == 0) break;
-      if (in_size == 0 && out_size == 0) break;
-    }
-    if (written != out.size()) throw FormatError("mcap: lz4 chunk is shorter than declared");
-    return out;
-  }
+  if (compression == "zstd") return decompress_zstd(bytes, uncompressed_size);
+  if (compression == "lz4") return decompress_lz4(bytes, uncompressed_size);
   throw FormatError("mcap: unknown chunk compression '" + std::string(compression) + "'");
 }
 

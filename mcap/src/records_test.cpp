@@ -197,5 +197,35 @@ TEST(McapCompression, NamesAndUnknown) {
   EXPECT_THROW(decompress("zstd", bytes_of("x"), std::uint64_t{1} << 40), FormatError);
 }
 
+// A chunk whose declared size lies far above what its bytes hold: a
+// FormatError once the real output ends, never an allocation of the lie (a
+// vector of 2^62 bytes would throw std::length_error or std::bad_alloc here).
+TEST_P(McapCompression, AHugeDeclaredSizeIsAFormatErrorNotAnAllocation) {
+  if (GetParam() == Compression::None) GTEST_SKIP() << "stored as is: the sizes must agree";
+  std::vector<std::uint8_t> input(100000);
+  for (std::size_t i = 0; i < input.size(); ++i) input[i] = static_cast<std::uint8_t>(i * 31 / 7);
+  const auto packed = compress(GetParam(), input);
+  const std::string name(compression_name(GetParam()));
+  for (const std::uint64_t lie :
+       {std::uint64_t{1} << 40, std::uint64_t{1} << 62, ~std::uint64_t{0}}) {
+    try {
+      decompress(name, packed, lie);
+      ADD_FAILURE() << "declared " << lie << " accepted";
+    } catch (const FormatError& error) {
+      EXPECT_NE(std::string(error.what()).find(std::to_string(lie)), std::string::npos)
+          << error.what();
+    }
+  }
+  EXPECT_THROW(decompress(name, packed, input.size() - 1), FormatError) << "more than declared";
+}
+
+// Highly compressible records (a zeroed 4 MiB point cloud) decompress,
+// whatever their ratio.
+TEST_P(McapCompression, ZerosDecompressWhateverTheRatio) {
+  const std::vector<std::uint8_t> zeros(4 << 20, 0);
+  const auto packed = compress(GetParam(), zeros);
+  EXPECT_EQ(decompress(compression_name(GetParam()), packed, zeros.size()), zeros);
+}
+
 }  // namespace
 }  // namespace agnocast::mcap

@@ -128,8 +128,26 @@ for (const type of ["Header", "Schema", "Channel", "Message", "DataEnd", "Statis
 }
 checkMessages(streamed, channels, schemas, "streamed");
 
+// The standard types' schemas carry their .msg text whole, as rosbag2 writes
+// it: PointCloud2's holds PointField's constants, which the parser sees.
+let pointFieldSchemas = 0;
+for (const schema of schemas.values()) {
+  const definitions = parse(new TextDecoder().decode(schema.data), { ros2: true });
+  const pointField = definitions.find((d) => /^sensor_msgs\/(msg\/)?PointField$/.test(d.name ?? ""));
+  if (!pointField) continue;
+  pointFieldSchemas += 1;
+  const constant = pointField.definitions.find((d) => d.isConstant && d.name === "FLOAT32");
+  if (!constant || Number(constant.value) !== 7) {
+    fail(`schema ${schema.name}: PointField has no constant FLOAT32 = 7`);
+  }
+  if (pointField.definitions.filter((d) => d.isConstant).length !== 8) {
+    fail(`schema ${schema.name}: PointField has not its 8 constants`);
+  }
+}
+if (pointFieldSchemas === 0) fail("no schema uses sensor_msgs/PointField");
+
 if (failures > 0) {
   console.error(`${file}: ${failures} failures`);
   process.exit(1);
 }
-console.log(`${file}: ${expected.length} messages read back by @mcap/core (indexed and streamed) and decoded by @foxglove/rosmsg2-serialization`);
+console.log(`${file}: ${expected.length} messages read back by @mcap/core (indexed and streamed) and decoded by @foxglove/rosmsg2-serialization, constants seen`);

@@ -4,6 +4,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <utility>
+#include <vector>
 
 #include "agnocast/mcap/writer.hpp"
 #include "bag/bag.hpp"
@@ -95,6 +98,54 @@ TEST_F(BagInfo, WhatIsNotMcapIsAnInputErrorNamingTheFile) {
     ADD_FAILURE() << "a missing file was read";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find(missing), std::string::npos);
+  }
+}
+
+// Hostile files: huge or short lengths, a chunk's size lie, a wrong opcode,
+// a bad CRC. bag info names the file in its error (exit 2) or says the file
+// is incomplete and why; it never crashes or allocates a declared size.
+TEST_F(BagInfo, HostileFilesAreAnErrorNamingTheFileOrIncomplete) {
+  const std::string original = write_file();
+  const std::string path = (dir_ / "hostile.mcap").string();
+  auto patch = [&](std::uint64_t offset, const auto value) {
+    std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(static_cast<std::streamoff>(offset));
+    file.write(reinterpret_cast<const char*>(&value), sizeof value);
+  };
+  const std::uint64_t size = fs::file_size(original);
+  // The magic (8) and the Header record come first; the first chunk follows.
+  std::uint64_t first_chunk = 0;
+  {
+    std::ifstream in(original, std::ios::binary);
+    in.seekg(9);
+    std::uint64_t header_length = 0;
+    in.read(reinterpret_cast<char*>(&header_length), sizeof header_length);
+    first_chunk = 8 + 9 + header_length;
+  }
+  const std::vector<std::pair<const char*, std::function<void()>>> cases{
+      {"the Header's length past the end", [&] { patch(9, std::uint64_t{1} << 62); }},
+      {"a chunk's length of 2^63", [&] { patch(first_chunk + 1, std::uint64_t{1} << 63); }},
+      {"a chunk declaring 2^60 bytes",
+       [&] { patch(first_chunk + 9 + 16, std::uint64_t{1} << 60); }},
+      {"a chunk's CRC wrong", [&] { patch(first_chunk + 9 + 24, std::uint32_t{0xDEADBEEF}); }},
+      {"a wrong opcode", [&] { patch(first_chunk, std::uint8_t{0x7F}); }},
+      {"the summary's CRC wrong", [&] { patch(size - 8 - 4, std::uint32_t{0xDEADBEEF}); }},
+      {"a summary offset past the end", [&] { patch(size - 8 - 20, ~std::uint64_t{0} >> 1); }},
+  };
+  for (const auto& [what, damage] : cases) {
+    SCOPED_TRACE(what);
+    fs::copy_file(original, path, fs::copy_options::overwrite_existing);
+    damage();
+    try {
+      const nlohmann::json info = bag_info_json(path);
+      if (info["complete"] == false) {
+        EXPECT_FALSE(info["incomplete_reason"].get<std::string>().empty());
+      } else {
+        EXPECT_EQ(info["messages"], 112) << "a complete summary is the file's";
+      }
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(path), std::string::npos) << error.what();
+    }
   }
 }
 

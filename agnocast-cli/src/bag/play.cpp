@@ -19,6 +19,7 @@
 #include "agnocast/schema_publisher.hpp"
 #include "agnocast/signals.hpp"
 #include "bag/bag.hpp"
+#include "standard_types.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -76,11 +77,17 @@ int bag_play(const BagPlayOptions& options, std::ostream& out) {
     } else if (channel.metadata.contains("agnocast_schema")) {
       type_hash = std::stoull(channel.metadata.at("agnocast_type_hash"), nullptr, 16);
       blob = from_hex(channel.metadata.at("agnocast_schema"));
+    } else if (const detail::MessageType* standard = standard_message_type(type_name)) {
+      // A file from another tool, of a standard type: laid out as the
+      // generated headers lay it out, which is what its subscribers expect.
+      type_hash = standard->hash;
+      blob.assign(standard->schema.begin(), standard->schema.end());
     }
     if (blob.empty()) {
       throw InputError(options.path + ": no layout known for topic '" + channel.topic + "' (" +
                        type_name +
-                       "): start a subscriber of it first, or record the file with agnocast");
+                       ", not a standard type): start a subscriber of it first, or record the "
+                       "file with agnocast");
     }
     std::unique_ptr<SchemaPublisher> played;
     try {

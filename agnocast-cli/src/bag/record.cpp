@@ -29,6 +29,7 @@
 #include "agnocast/signals.hpp"
 #include "agnocast/version.hpp"
 #include "bag/bag.hpp"
+#include "standard_msg_texts.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -163,7 +164,9 @@ class Recorder {
             take(*raw, message, info);
           });
       topic->type = topic->subscription->type_name();
-      topic->definition = ros2msg_definition(topic->subscription->schema());
+      // The standard types' own .msg text (constants and comments too), as
+      // rosbag2 writes it; other types' fields as the schema gives them.
+      topic->definition = ros2msg_definition(topic->subscription->schema(), standard_msg_text);
     } catch (const std::exception& error) {
       problem = error.what();
       return false;

@@ -5,13 +5,19 @@
 
 #include <agnocast/detail/message.hpp>
 #include <agnocast/schema_cdr.hpp>
+#include <algorithm>
 #include <geometry_msgs/msg/transform_stamped.hpp>
 #include <memory>
 #include <sensor_msgs/msg/imu.hpp>
 #include <sensor_msgs/msg/laser_scan.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "runtime.hpp"
+#include "standard_msg_texts.hpp"
+#include "standard_types.hpp"
 
 namespace {
 
@@ -155,6 +161,67 @@ TEST(SchemaCdr, FixedArraysHaveTheirLengthInTheDefinition) {
   EXPECT_NE(text.find("MSG: geometry_msgs/Quaternion\n"), std::string::npos) << text;
   // Vector3 is used twice, listed once.
   EXPECT_EQ(text.find("MSG: geometry_msgs/Vector3\n"), text.rfind("MSG: geometry_msgs/Vector3\n"));
+}
+
+// With the standard texts compiled in, each standard type's definition is its
+// whole .msg file, constants and comments included, as rosbag2 writes it.
+TEST(SchemaCdr, StandardTypesKeepTheirConstantsAndComments) {
+  const agnocast::Schema schema =
+      agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::PointCloud2>());
+  const std::string text = agnocast::ros2msg_definition(schema, agnocast::standard_msg_text);
+  const std::string_view* point_field = agnocast::standard_msg_text("sensor_msgs/msg/PointField");
+  ASSERT_NE(point_field, nullptr);
+  EXPECT_NE(text.find("uint8 FLOAT32=7\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nMSG: sensor_msgs/PointField\n" + std::string(*point_field)),
+            std::string::npos)
+      << text;
+  const std::string_view* cloud = agnocast::standard_msg_text("sensor_msgs/PointCloud2");
+  ASSERT_NE(cloud, nullptr);
+  EXPECT_EQ(text.rfind(std::string(*cloud), 0), 0U) << "the root's own text comes first";
+  EXPECT_NE(text.find("\nMSG: std_msgs/Header\n"), std::string::npos);
+  EXPECT_EQ(agnocast::standard_msg_text("robot/msg/Scan"), nullptr);
+}
+
+// bag play lays out a foreign file's standard types as the generated
+// headers do: the same name, hash and schema a compiled subscriber registers.
+TEST(SchemaCdr, StandardTypesAreKnownByNameAsTheirHeadersDeclareThem) {
+  const agnocast::detail::MessageType expected =
+      agnocast::detail::message_type_of<sensor_msgs::msg::PointCloud2>();
+  const agnocast::detail::MessageType* known =
+      agnocast::standard_message_type("sensor_msgs/msg/PointCloud2");
+  ASSERT_NE(known, nullptr);
+  EXPECT_EQ(known->name, expected.name);
+  EXPECT_EQ(known->hash, expected.hash);
+  EXPECT_TRUE(std::equal(known->schema.begin(), known->schema.end(), expected.schema.begin(),
+                         expected.schema.end()));
+  EXPECT_NE(agnocast::standard_message_type("geometry_msgs/msg/TransformStamped"), nullptr);
+  EXPECT_NE(agnocast::standard_message_type("tf2_msgs/msg/TFMessage"), nullptr);
+  EXPECT_EQ(agnocast::standard_message_type("robot/msg/Scan"), nullptr);
+}
+
+TEST(SchemaCdr, FieldNamesOfAMsgTextSkipConstantsAndComments) {
+  EXPECT_EQ(agnocast::msg_text_field_names("# a comment\n"
+                                           "uint8 A=1\n"
+                                           "int32 B = -2  # spaced\n"
+                                           "string C=\"x#y\"\n"
+                                           "\n"
+                                           "string<=8 name  # bounded\n"
+                                           "float64[3] values\n"
+                                           "int32 count 5\n"),
+            (std::vector<std::string>{"name", "values", "count"}));
+}
+
+// A known name whose fields differ (a user's own type of the same name)
+// gets the fields from the schema, not the standard text.
+TEST(SchemaCdr, AKnownNameWithOtherFieldsIsWrittenFromTheSchema) {
+  const agnocast::Schema schema =
+      agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::PointCloud2>());
+  const std::string_view other = "# not the real one\nint32 only\n";
+  const std::string text =
+      agnocast::ros2msg_definition(schema, [&](std::string_view name) -> const std::string_view* {
+        return name == "sensor_msgs/msg/PointField" ? &other : nullptr;
+      });
+  EXPECT_EQ(text, agnocast::ros2msg_definition(schema));
 }
 
 }  // namespace

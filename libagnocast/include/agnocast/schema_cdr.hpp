@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -42,5 +43,15 @@ std::string ros2msg_type_name(std::string_view type_name);
 // Constants and comments are not in the schema, so not in the text.
 // Throws cdr::Error for a type without field descriptions.
 std::string ros2msg_definition(const Schema& schema);
+
+// The same, with each type's own .msg text (constants and comments included,
+// as rosbag2 writes it) where text_of("pkg/msg/Name") gives one (nullptr:
+// none). A text is used only when its fields are the schema type's, by name
+// and in order; else that type's fields are written from the schema.
+using MsgTextLookup = std::function<const std::string_view*(std::string_view type_name)>;
+std::string ros2msg_definition(const Schema& schema, const MsgTextLookup& text_of);
+
+// The field names of a .msg text, in order (constants and comments skipped).
+std::vector<std::string> msg_text_field_names(std::string_view text);
 
 }  // namespace agnocast

@@ -102,7 +102,8 @@ void* HeapRouter::pool_allocate(const agnocast_heaphook_pool& pool, std::size_t 
   // The pool's own bookkeeping (a reclaim round, an exception it catches)
   // must not come back here.
   this_thread.routing_off = true;
-  void* ptr = pool.allocate(size == 0 ? 1 : size, align < malloc_alignment ? malloc_alignment : align);
+  void* ptr =
+      pool.allocate(size == 0 ? 1 : size, align < malloc_alignment ? malloc_alignment : align);
   this_thread.routing_off = false;
   if (ptr) return ptr;
   if (!exhaustion_reported_.exchange(true)) {

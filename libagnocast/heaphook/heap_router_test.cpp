@@ -3,11 +3,11 @@
 #include "heap_router.hpp"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <malloc.h>
 #include <mutex>
 #include <new>
 #include <string>
@@ -51,7 +51,7 @@ std::size_t system_usable(void* ptr) {
 }
 void record_report(const char* line, std::size_t length) { reports.emplace_back(line, length); }
 
-constexpr SystemHeap fake_system{system_malloc, system_free,   system_calloc, system_realloc,
+constexpr SystemHeap fake_system{system_malloc,   system_free,   system_calloc, system_realloc,
                                  system_memalign, system_usable, record_report};
 
 // The fake pool: what libagnocast's pool functions do, over a test buffer.
@@ -190,7 +190,7 @@ TEST_F(HeapRouterTest, ReallocMovesABlockToWhereMallocWouldPutItNow) {
     pooled = static_cast<char*>(router.realloc(private_block, 10000));  // grows into the pool
     ASSERT_TRUE(router.in_pool(pooled));
     EXPECT_STREQ(pooled, "private bytes");
-    EXPECT_EQ(system_counts.free, 1);  // the private block is gone
+    EXPECT_EQ(system_counts.free, 1);                                  // the private block is gone
     char* grown = static_cast<char*>(router.realloc(pooled, 100000));  // pool to pool
     ASSERT_TRUE(router.in_pool(grown));
     EXPECT_STREQ(grown, "private bytes");
@@ -204,7 +204,7 @@ TEST_F(HeapRouterTest, ReallocMovesABlockToWhereMallocWouldPutItNow) {
   ASSERT_FALSE(router.in_pool(back));
   EXPECT_STREQ(back, "private bytes");
   EXPECT_EQ(FakePool::frees, pool_frees + 1);
-  EXPECT_EQ(system_counts.realloc, 0);  // glibc never saw a pool pointer
+  EXPECT_EQ(system_counts.realloc, 0);                           // glibc never saw a pool pointer
   char* plain = static_cast<char*>(router.realloc(back, 5000));  // glibc's own business
   EXPECT_EQ(system_counts.realloc, 1);
   EXPECT_STREQ(plain, "private bytes");

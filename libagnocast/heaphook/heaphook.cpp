@@ -93,8 +93,12 @@ void* reallocarray(void* ptr, std::size_t count, std::size_t size) noexcept {
   }
   return router.realloc(ptr, bytes);
 }
-void* memalign(std::size_t align, std::size_t size) noexcept { return router.memalign(align, size); }
-void* aligned_alloc(std::size_t align, std::size_t size) noexcept { return router.memalign(align, size); }
+void* memalign(std::size_t align, std::size_t size) noexcept {
+  return router.memalign(align, size);
+}
+void* aligned_alloc(std::size_t align, std::size_t size) noexcept {
+  return router.memalign(align, size);
+}
 int posix_memalign(void** out, std::size_t align, std::size_t size) noexcept {
   return router.posix_memalign(out, align, size);
 }
@@ -113,8 +117,8 @@ std::size_t malloc_usable_size(void* ptr) noexcept { return router.usable_size(p
 
 const agnocast_heaphook_interface* agnocast_heaphook_get_interface(void) {
   static constexpr struct agnocast_heaphook_interface interface {
-    AGNOCAST_HEAPHOOK_INTERFACE_VERSION, agnocast_heaphook_malloc,
-        agnocast::heaphook::attach_pool, HeapRouter::enter_scope, HeapRouter::leave_scope
+    AGNOCAST_HEAPHOOK_INTERFACE_VERSION, agnocast_heaphook_malloc, agnocast::heaphook::attach_pool,
+        HeapRouter::enter_scope, HeapRouter::leave_scope
   };
   return &interface;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -72,6 +73,10 @@ int main(int argc, char** argv) {
   std::size_t received = 0;
   std::string failure;
   agnocast::ipc_shared_ptr<const seed::Msg> last;
+  // The pool is as large as the module's pool_size: search the part the
+  // messages used and well beyond it, where the allocator would have put
+  // anything else allocated in the scope.
+  std::uintptr_t used_end = 0;
   try {
     agnocast::Node node{"heap_subscriber"};
     auto subscription = node.create_subscription<seed::Msg>(
@@ -85,6 +90,11 @@ int main(int argc, char** argv) {
             ++received;
           }
           last = msg;
+          used_end = std::max(used_end, reinterpret_cast<std::uintptr_t>(msg.get() + 1));
+          for (const void* member : {static_cast<const void*>(msg->payload.data()),
+                                     static_cast<const void*>(msg->points.data())}) {
+            used_end = std::max(used_end, reinterpret_cast<std::uintptr_t>(member));
+          }
         });
     agnocast::SingleThreadedExecutor executor;
     executor.add_node(node);
@@ -97,8 +107,9 @@ int main(int argc, char** argv) {
     }
     if (failure.empty()) {
       const seed::Mapping pool = seed::mapping_of(last.get());
+      const std::uintptr_t margin = 16 << 20;
       const char* begin = reinterpret_cast<const char*>(pool.begin);
-      const char* end = reinterpret_cast<const char*>(pool.end);
+      const char* end = reinterpret_cast<const char*>(std::min(pool.end, used_end + margin));
       if (std::search(begin, end, secret.begin(), secret.end()) != end) {
         failure = "the publisher's secret is readable in its pool";
       }

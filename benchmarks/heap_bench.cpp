@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <csignal>
 #include <cstdio>
 #include <string>
 #include <sys/wait.h>
@@ -138,12 +139,17 @@ int main(int argc, char** argv) {
   const pid_t child = ::fork();
   if (child == 0) {
     ::close(pipe_fds[0]);
-    ::_exit(subscribe(topic, samples, pipe_fds[1]));
+    try {
+      ::_exit(subscribe(topic, samples, pipe_fds[1]));
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "agnocast-bench-heap: subscriber: %s\n", error.what());
+      ::_exit(1);
+    }
   }
   ::close(pipe_fds[1]);
 
   std::vector<std::int64_t> fill_std, fill_agnocast, fill_private;
-  {
+  try {
     agnocast::Node node{"bench_heap_publisher"};
     auto std_pub = node.create_publisher<bench::StdCloud>(topic + "/std", agnocast::QoS{10});
     auto agnocast_pub =
@@ -171,6 +177,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "agnocast-bench-heap: the subscriber did not receive everything\n");
       return 1;
     }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "agnocast-bench-heap: %s\n", error.what());
+    ::kill(child, SIGTERM);
+    return 1;
   }
   std::vector<std::int64_t> latency_std, latency_agnocast;
   FILE* in = ::fdopen(pipe_fds[0], "r");

@@ -6,17 +6,18 @@
 // sample). A third row fills the std message outside any loan, from glibc
 // behind the hook: what the hook costs an ordinary allocation.
 // Linked with agnocast::heaphook; needs the kernel module (run it in the VM).
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <agnocast/agnocast.hpp>
 #include <algorithm>
 #include <chrono>
-#include <cstdint>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <string>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 #include <vector>
 
 namespace bench {
@@ -45,8 +46,8 @@ struct AgnocastCloud {
 
 AGNOCAST_HEAP_MESSAGE(bench::StdCloud, "bench/msg/StdCloud", seq, stamp_ns, frame_id, payload,
                       points);
-AGNOCAST_MESSAGE(bench::AgnocastCloud, "bench/msg/AgnocastCloud", seq, stamp_ns, frame_id,
-                 payload, points);
+AGNOCAST_MESSAGE(bench::AgnocastCloud, "bench/msg/AgnocastCloud", seq, stamp_ns, frame_id, payload,
+                 points);
 
 namespace {
 
@@ -86,8 +87,8 @@ int subscribe(const std::string& topic, std::size_t samples, int out) {
   auto record = [&](char kind, std::int64_t stamp) {
     const std::int64_t latency = now_ns() - stamp;
     char line[64];
-    const int length = std::snprintf(line, sizeof line, "%c %lld\n", kind,
-                                     static_cast<long long>(latency));
+    const int length =
+        std::snprintf(line, sizeof line, "%c %lld\n", kind, static_cast<long long>(latency));
     (void)!::write(out, line, static_cast<std::size_t>(length));
     ++received;
   };
@@ -193,8 +194,8 @@ int main(int argc, char** argv) {
 
   std::printf("%zu messages of each type: %zu payload bytes, %zu points added one by one\n",
               samples, shape.payload_bytes, shape.points);
-  std::printf("%-38s %12s %12s %12s %12s\n", "message", "fill p50 us", "fill p99 us",
-              "latency p50", "latency p99");
+  std::printf("%-38s %12s %12s %12s %12s\n", "message", "fill p50 us", "fill p99 us", "latency p50",
+              "latency p99");
   auto row = [](const char* name, const std::vector<std::int64_t>& fill,
                 const std::vector<std::int64_t>* latencies) {
     std::printf("%-38s %12.1f %12.1f", name, percentile(fill, 0.5), percentile(fill, 0.99));

@@ -66,10 +66,9 @@ void fill(seed::Msg& msg, std::uint64_t seq, const std::string& secret) {
   std::free(grown);
   // A private copy made on another thread during the loan stays private.
   std::thread([&] { keep_secret(secret); }).join();
-  for (const void* member : {static_cast<const void*>(msg.payload.data()),
-                             static_cast<const void*>(msg.frame_id.data()),
-                             static_cast<const void*>(msg.points.data()),
-                             static_cast<const void*>(msg.tags.data())}) {
+  for (const void* member :
+       {static_cast<const void*>(msg.payload.data()), static_cast<const void*>(msg.frame_id.data()),
+        static_cast<const void*>(msg.points.data()), static_cast<const void*>(msg.tags.data())}) {
     if (!pool.contains(member)) fail("a member of message " + std::to_string(seq) + " is private");
   }
 }

@@ -5,8 +5,8 @@
 #include <agnocast/agnocast.hpp>
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -20,10 +20,9 @@ namespace {
 std::string check(const seed::Msg& msg) {
   const std::uint64_t seq = msg.seq;
   const seed::Mapping pool = seed::mapping_of(&msg);
-  for (const void* member : {static_cast<const void*>(msg.payload.data()),
-                             static_cast<const void*>(msg.frame_id.data()),
-                             static_cast<const void*>(msg.points.data()),
-                             static_cast<const void*>(msg.tags.data())}) {
+  for (const void* member :
+       {static_cast<const void*>(msg.payload.data()), static_cast<const void*>(msg.frame_id.data()),
+        static_cast<const void*>(msg.points.data()), static_cast<const void*>(msg.tags.data())}) {
     if (!pool.contains(member)) return "a member lies outside the publisher's pool";
   }
   if (msg.payload.size() != seed::payload_size(seq)) return "payload size";
@@ -34,7 +33,8 @@ std::string check(const seed::Msg& msg) {
   if (msg.points.size() != seed::point_count(seq)) return "point count";
   for (std::size_t i = 0; i < msg.points.size(); ++i) {
     const seed::Point& point = msg.points[i];
-    if (point.x != static_cast<double>(seq) || point.y != static_cast<double>(i) || point.z != 0.5) {
+    if (point.x != static_cast<double>(seq) || point.y != static_cast<double>(i) ||
+        point.z != 0.5) {
       return "point " + std::to_string(i);
     }
   }

@@ -85,11 +85,13 @@ const agnocast_heaphook_pool* HeapRouter::routing_pool() const noexcept {
   return pool_.load(std::memory_order_acquire);
 }
 
-bool HeapRouter::in_pool(const void* ptr) const noexcept {
+const agnocast_heaphook_pool* HeapRouter::pool_owning(const void* ptr) const noexcept {
   const agnocast_heaphook_pool* pool = pool_.load(std::memory_order_acquire);
   const auto at = reinterpret_cast<std::uintptr_t>(ptr);
-  return pool != nullptr && at >= pool->begin && at - pool->begin < pool->size;
+  return pool != nullptr && at >= pool->begin && at - pool->begin < pool->size ? pool : nullptr;
 }
+
+bool HeapRouter::in_pool(const void* ptr) const noexcept { return pool_owning(ptr) != nullptr; }
 
 bool HeapRouter::in_retired(const void* ptr) const noexcept {
   const auto at = reinterpret_cast<std::uintptr_t>(ptr);
@@ -126,8 +128,7 @@ void* HeapRouter::malloc(std::size_t size) noexcept {
 
 void HeapRouter::free(void* ptr) noexcept {
   if (ptr == nullptr) return;
-  if (in_pool(ptr)) {
-    const agnocast_heaphook_pool* pool = pool_.load(std::memory_order_acquire);
+  if (const agnocast_heaphook_pool* pool = pool_owning(ptr)) {
     const bool was_off = this_thread.routing_off;
     this_thread.routing_off = true;
     pool->deallocate(ptr);
@@ -197,8 +198,7 @@ int HeapRouter::posix_memalign(void** out, std::size_t align, std::size_t size) 
 
 std::size_t HeapRouter::usable_size(void* ptr) noexcept {
   if (ptr == nullptr || in_retired(ptr)) return 0;
-  if (in_pool(ptr)) {
-    const agnocast_heaphook_pool* pool = pool_.load(std::memory_order_acquire);
+  if (const agnocast_heaphook_pool* pool = pool_owning(ptr)) {
     const bool was_off = this_thread.routing_off;
     this_thread.routing_off = true;
     const std::size_t size = pool->usable_size(ptr);

@@ -64,7 +64,10 @@ class HeapRouter {
   bool in_pool(const void* ptr) const noexcept;
 
  private:
+  // The pool allocations go to now, or nullptr: outside a scope, or none attached.
   const agnocast_heaphook_pool* routing_pool() const noexcept;
+  // The attached pool if ptr lies in it, else nullptr.
+  const agnocast_heaphook_pool* pool_owning(const void* ptr) const noexcept;
   void* pool_allocate(const agnocast_heaphook_pool& pool, std::size_t size,
                       std::size_t align) noexcept;
   bool in_retired(const void* ptr) const noexcept;

@@ -29,8 +29,8 @@ class FakeRuntimeTest : public ::testing::Test {
     auto kernel = std::make_unique<FakeKernel>();
     kernel_ = kernel.get();
     // Leaked with the runtime on purpose: pointers into it may survive a test.
-    void* region = new (std::align_val_t{4096}) std::byte[pool_size];
-    runtime_ = &Runtime::install_for_testing(region, pool_size, std::move(kernel));
+    region_ = new (std::align_val_t{4096}) std::byte[pool_size];
+    runtime_ = &Runtime::install_for_testing(region_, pool_size, std::move(kernel));
   }
 
   // Unique among concurrently running test binaries: queues are system-wide.
@@ -40,10 +40,12 @@ class FakeRuntimeTest : public ::testing::Test {
 
   FakeKernel& kernel() { return *kernel_; }
   Runtime& runtime() { return *runtime_; }
+  const void* runtime_region() const { return region_; }
 
  private:
   FakeKernel* kernel_ = nullptr;
   Runtime* runtime_ = nullptr;
+  std::byte* region_ = nullptr;
 };
 
 }  // namespace agnocast::detail

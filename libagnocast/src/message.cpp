@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <utility>
 
 #include "agnocast/allocator.hpp"
+#include "agnocast/heap_scope.hpp"
 #include "runtime.hpp"
 #include "tlsf.hpp"
 
@@ -28,8 +30,15 @@ void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void
   void* block = Runtime::get().allocate(offset + size, align);
   void* message = static_cast<char*>(block) + offset;
   const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
-  *header_of(message) = MessageHeader{destroy, block, &thread_counter, thread_counter, 0, 0};
+  *header_of(message) =
+      MessageHeader{nullptr, destroy, block, &thread_counter, thread_counter, 0, 0};
   return message;
+}
+
+void open_loan_heap_scope(void* message) { header_of(message)->heap_scope = enter_heap_scope(); }
+
+void close_loan_heap_scope(void* message) noexcept {
+  leave_heap_scope(std::exchange(header_of(message)->heap_scope, nullptr));
 }
 
 std::uint64_t published_bytes(void* message, std::size_t size) noexcept {
@@ -58,9 +67,13 @@ Publication read_publication(const void* message, const void* pool_begin,
   return Publication{header->publish_time, header->published_bytes};
 }
 
-void free_message_memory(void* message) noexcept { pool_deallocate(header_of(message)->block); }
+void free_message_memory(void* message) noexcept {
+  close_loan_heap_scope(message);
+  pool_deallocate(header_of(message)->block);
+}
 
 void discard_message(void* message) noexcept {
+  close_loan_heap_scope(message);
   const MessageHeader header = *header_of(message);
   header.destroy(message);
   pool_deallocate(header.block);

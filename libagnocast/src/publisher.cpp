@@ -81,6 +81,8 @@ bool PublisherCore::wait_for_subscribers(std::size_t count,
 }
 
 void PublisherCore::publish(void* message, std::size_t bytes) {
+  // The message is complete: what publishing allocates is the library's own.
+  close_loan_heap_scope(message);
   State& state = *state_;
   if (Runtime::current() != &state.runtime) {
     throw Error(

@@ -16,6 +16,7 @@
 #include "agnocast/detail/message.hpp"
 #include "agnocast/errors.hpp"
 #include "device.hpp"
+#include "heap_hook.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -120,6 +121,7 @@ Runtime* Runtime::create() {
   auto* runtime = new Runtime(std::make_unique<Device>(std::move(device)), slot.pid,
                               reinterpret_cast<void*>(slot.addr), slot.size);
   runtime->pool_mapped_here_ = true;
+  attach_pool_to_heap_hook(runtime->pool_addr_, runtime->pool_size_);
   return runtime;
 }
 
@@ -129,6 +131,7 @@ Runtime& Runtime::install_for_testing(void* region, std::size_t size,
   Runtime* runtime = new Runtime(std::move(kernel), ::getpid(), region, size);
   // Any earlier test runtime is leaked on purpose: pointers into it may survive.
   instance.store(runtime, std::memory_order_release);
+  attach_pool_to_heap_hook(region, size);
   return *runtime;
 }
 
@@ -171,6 +174,11 @@ void Runtime::deallocate(void* ptr) noexcept {
   if (!ptr || !pool_.owns(ptr)) return;  // never free into another process's pool
   std::lock_guard lock(pool_mutex_);
   pool_.free(ptr);
+}
+
+std::size_t Runtime::usable_size(const void* ptr) const {
+  std::lock_guard lock(pool_mutex_);
+  return pool_.usable_size(ptr);
 }
 
 Tlsf::Stats Runtime::pool_stats() const {

@@ -36,6 +36,8 @@ class Runtime {
   void* allocate(std::size_t size, std::size_t align);
   void deallocate(void* ptr) noexcept;
   bool owns(const void* ptr) const { return pool_.owns(ptr); }
+  // Bytes usable at ptr, a live allocation of this pool.
+  std::size_t usable_size(const void* ptr) const;
   Tlsf::Stats pool_stats() const;
 
   // Destroys and frees messages the kernel reported as no longer referenced.

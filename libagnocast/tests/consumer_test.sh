@@ -1,7 +1,8 @@
 #!/bin/sh
 # Installs the library from the build tree into a scratch prefix, then builds
 # and runs a tiny consumer with find_package and with pkg-config; the CMake
-# consumer also generates its own message with agnocast_generate_messages().
+# consumer also generates its own message with agnocast_generate_messages()
+# and links the allocation hook (agnocast::heaphook).
 # usage: consumer_test.sh BUILD_DIR CONSUMER_SOURCE_DIR SCRATCH_DIR
 set -eu
 build=$1 source=$2 scratch=$3
@@ -18,6 +19,9 @@ cmake -S "$source" -B "$scratch/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" >/dev
 cmake --build "$scratch/cmake-build" >/dev/null
 libdir=$(dirname "$(find "$prefix" -name 'libagnocast.so' | head -n1)")
 LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/consumer" | grep -q '^agnocast '
+# The allocation hook, linked through its CMake target and preloaded by its file.
+LD_LIBRARY_PATH=$libdir "$scratch/cmake-build/heap_consumer" | grep -qx 'heaphook active'
+LD_LIBRARY_PATH=$libdir LD_PRELOAD=$libdir/libagnocast_heaphook.so "$scratch/cmake-build/consumer" | grep -q '^agnocast '
 
 pcdir=$(dirname "$(find "$prefix" -name agnocast.pc | head -n1)")
 export PKG_CONFIG_PATH=$pcdir

@@ -5,6 +5,7 @@
 #include "agnocast/callback_group.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/executor.hpp"
+#include "agnocast/heap_scope.hpp"
 #include "agnocast/ipc_shared_ptr.hpp"
 #include "agnocast/log.hpp"
 #include "agnocast/message.hpp"

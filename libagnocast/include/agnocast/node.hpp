@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "agnocast/callback_group.hpp"
+#include "agnocast/heap_scope.hpp"
 #include "agnocast/message_traits.hpp"
 #include "agnocast/publisher.hpp"
 #include "agnocast/qos.hpp"
@@ -32,6 +33,7 @@ class Node {
   template <class T>
   std::shared_ptr<Publisher<T>> create_publisher(std::string_view topic, const QoS& qos) {
     static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
+    if constexpr (HeapMessage<T>) detail::require_heap_hook(message_traits<T>::type_name);
     return std::make_shared<Publisher<T>>(state_, topic, qos);
   }
 

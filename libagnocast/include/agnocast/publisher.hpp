@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "agnocast/detail/endpoints.hpp"
+#include "agnocast/heap_scope.hpp"
 #include "agnocast/ipc_shared_ptr.hpp"
 
 namespace agnocast {
@@ -25,11 +26,14 @@ class Publisher {
       : core_(std::move(node), topic, qos, detail::message_type_of<T>()) {}
 
   // A default-constructed T in this process's shared pool, for you to fill in.
+  // For a heap message (AGNOCAST_HEAP_MESSAGE), this thread allocates in the
+  // pool until the loan is published or dropped (heap_scope.hpp).
   ipc_shared_ptr<T> borrow_loaned_message() {
     void* memory =
         detail::allocate_message(sizeof(T), alignof(T), &detail::destroy_message_object<T>);
     T* message;
     try {
+      if constexpr (HeapMessage<T>) detail::open_loan_heap_scope(memory);
       message = new (memory) T();
     } catch (...) {
       detail::free_message_memory(memory);

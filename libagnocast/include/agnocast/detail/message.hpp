@@ -13,6 +13,10 @@ namespace agnocast::detail {
 // Subscribers never write it; the publisher uses it to destroy the message
 // when the kernel reports it reclaimable, even after the Publisher is gone.
 struct MessageHeader {
+  // The borrowing thread's heap scope (heap_scope.hpp) while the loan is
+  // unpublished, else nullptr. First, so that the fields subscribers read
+  // keep their distance from the message.
+  void* heap_scope;
   void (*destroy)(void* message);
   void* block;  // the pool allocation that holds header and message
   // For the bandwidth counter: which thread borrowed the message and how many
@@ -31,6 +35,11 @@ void destroy_message_object(void* message) {
 
 // Pool memory for a message of size/align, header filled; returns the message address.
 void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*));
+// Opens a heap scope on the calling thread for the loan's lifetime (a message
+// type that keeps its members on the heap); closed at publish or discard.
+void open_loan_heap_scope(void* message);
+// Closes the loan's heap scope, if it has one (from any thread).
+void close_loan_heap_scope(void* message) noexcept;
 // The message's size for the kernel's bandwidth counter: its own size plus
 // what the publishing thread allocated from the pool since borrowing it (the
 // vectors and strings filled in).  Just `size` when another thread borrowed it.

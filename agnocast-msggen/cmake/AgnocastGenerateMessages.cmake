@@ -80,5 +80,6 @@ function(agnocast_generate_messages target)
   set_target_properties(${target} PROPERTIES
     AGNOCAST_MSG_INCLUDES "${includes}"
     AGNOCAST_PACKAGE ${arg_PACKAGE}
+    AGNOCAST_MSG_FILES "${inputs}"
     AGNOCAST_HEADER_DIR ${output_dir})
 endfunction()

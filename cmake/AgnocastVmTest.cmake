@@ -3,19 +3,24 @@
 # per test (vm.<NAME>).
 #
 #   agnocast_add_vm_test(NAME name COMMAND program [args...]
-#                        [TIMEOUT seconds] [TARGETS target...] [FILES path...])
+#                        [TIMEOUT seconds] [TARGETS target...] [FILES path...]
+#                        [TREES "path[|exclude...]"...])
 #
 # COMMAND's program is a target (its binary is copied into the VM) or a file
 # path (copied too); either is run by its file name from /opt/agnocast/bin,
 # which is on PATH.  TARGETS and FILES are further programs or data the test
 # needs, copied to the same place with every shared library they link.
+# TREES are host files or folders the test needs at the same absolute path in
+# the VM (an interpreter and its modules), each optionally followed by "|" and
+# space-separated tar --exclude patterns; every ELF file in them brings the
+# shared libraries it links.
 # The VM runs each test as root in a fresh /tmp/vm-tests/<NAME> directory with
 # agnocast.ko freshly loaded with default parameters, default mqueue limits
 # and empty /dev/mqueue and /dev/shm (the module path is $AGNOCAST_MODULE),
 # one after another;
 # TIMEOUT (default 120 s) bounds one test.
 function(agnocast_add_vm_test)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES;TREES")
   if(NOT arg_NAME OR NOT arg_COMMAND)
     message(FATAL_ERROR "agnocast_add_vm_test needs NAME and COMMAND")
   endif()
@@ -46,6 +51,10 @@ function(agnocast_add_vm_test)
   set(lines)
   foreach(file IN LISTS files)
     string(APPEND lines "file\t${file}\n")
+  endforeach()
+  foreach(tree IN LISTS arg_TREES)
+    string(REPLACE "|" "\t" tree "${tree}")
+    string(APPEND lines "tree\t${tree}\n")
   endforeach()
   string(APPEND lines "test\t${arg_NAME}\t${arg_TIMEOUT}\t${program_name} ${args}\n")
   set_property(GLOBAL APPEND_STRING PROPERTY AGNOCAST_VM_MANIFEST "${lines}")

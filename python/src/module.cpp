@@ -49,10 +49,34 @@ class ReadOnlyMessage : public Error {
 // destroyed (when the kernel reports it reclaimable) long after the Python
 // objects that made it are gone.
 struct MessageClass {
-  explicit MessageClass(std::vector<std::uint8_t> blob) : schema(std::move(blob)), ops(schema) {}
+  MessageClass(std::vector<std::uint8_t> blob, std::string default_image)
+      : schema(std::move(blob)), ops(schema), defaults(std::move(default_image)) {
+    if (!defaults.empty() && defaults.size() != type().size) {
+      throw SchemaError("agnocast: the default values of " + type().name + " have the wrong size");
+    }
+  }
   ErasedSchema schema;
   ErasedOps ops;
+  // A default-constructed message's bytes (empty: all zero); only its
+  // number fields are used, those of nested messages included.
+  std::string defaults;
   const SchemaType& type() const { return schema.type(0); }
+
+  // Gives a new message the .msg file's default values, as C++ construction does.
+  void apply_defaults(std::byte* message, const std::byte* image, std::uint16_t index) const {
+    for (const SchemaField& field : schema.type(index).fields) {
+      if (field.shape == FieldShape::Sequence || field.kind == FieldKind::String) continue;
+      if (field.kind != FieldKind::Message) {
+        std::memcpy(message + field.offset, image + field.offset, field.size);
+        continue;
+      }
+      const std::size_t count = field.shape == FieldShape::Array ? field.array_length : 1;
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t at = field.offset + i * field.element_size;
+        apply_defaults(message + at, image + at, field.nested);
+      }
+    }
+  }
 };
 
 std::mutex& class_mutex() {
@@ -82,12 +106,13 @@ void destroy_erased(void* message) {
   cls->ops.destroy(message, 0);
 }
 
-const MessageClass* message_class(py::bytes blob_bytes) {
+const MessageClass* message_class(py::bytes blob_bytes, py::bytes default_image) {
   const std::string text = blob_bytes;
   std::lock_guard lock(class_mutex());
   auto& map = classes();
   if (const auto found = map.find(text); found != map.end()) return found->second;
-  auto* cls = new MessageClass(std::vector<std::uint8_t>(text.begin(), text.end()));
+  auto* cls = new MessageClass(std::vector<std::uint8_t>(text.begin(), text.end()),
+                               std::string(default_image));
   map.emplace(text, cls);
   return cls;
 }
@@ -482,6 +507,10 @@ class PyPublisher {
     void* memory = detail::allocate_message(type.size, type.align, &destroy_erased);
     try {
       cls_->ops.construct(memory, 0);
+      if (!cls_->defaults.empty()) {
+        cls_->apply_defaults(static_cast<std::byte*>(memory),
+                             reinterpret_cast<const std::byte*>(cls_->defaults.data()), 0);
+      }
     } catch (...) {
       detail::free_message_memory(memory);
       throw;
@@ -676,8 +705,10 @@ PYBIND11_MODULE(_core, m) {
 
   py::class_<MessageClass, std::unique_ptr<MessageClass, py::nodelete>>(m, "MessageType",
                                                                         py::dynamic_attr())
-      .def(py::init([](py::bytes blob) { return const_cast<MessageClass*>(message_class(blob)); }),
-           py::arg("schema"))
+      .def(py::init([](py::bytes blob, py::bytes defaults) {
+             return const_cast<MessageClass*>(message_class(blob, defaults));
+           }),
+           py::arg("schema"), py::arg("defaults") = py::bytes())
       .def_property_readonly("type_name", [](const MessageClass& c) { return c.type().name; })
       .def("__repr__",
            [](const MessageClass& c) { return "<agnocast message type " + c.type().name + ">"; })

@@ -4,7 +4,7 @@
 #
 #   agnocast_add_vm_test(NAME name COMMAND program [args...]
 #                        [TIMEOUT seconds] [TARGETS target...] [FILES path...]
-#                        [OWN_FILES path...])
+#                        [OWN_FILES path...] [TREES "path[|exclude...]"...])
 #
 # COMMAND's program is a target (its binary is copied into the VM) or a file
 # path (copied too); either is run by its file name from /opt/agnocast/bin,
@@ -13,13 +13,17 @@
 # shared library they link.  OWN_FILES are copied likewise, but only into the
 # boots that run this test (large files, such as node, that no other kernel's
 # boot should carry).
+# TREES are host files or folders the test needs at the same absolute path in
+# the VM (an interpreter and its modules), each optionally followed by "|" and
+# space-separated tar --exclude patterns; every ELF file in them brings the
+# shared libraries it links.  Like OWN_FILES, they go only where the test runs.
 # The VM runs each test as root in a fresh /tmp/vm-tests/<NAME> directory with
 # agnocast.ko freshly loaded with default parameters, default mqueue limits
 # and empty /dev/mqueue and /dev/shm (the module path is $AGNOCAST_MODULE),
 # one after another;
 # TIMEOUT (default 120 s) bounds one test.
 function(agnocast_add_vm_test)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES;OWN_FILES")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;TIMEOUT" "COMMAND;TARGETS;FILES;OWN_FILES;TREES")
   if(NOT arg_NAME OR NOT arg_COMMAND)
     message(FATAL_ERROR "agnocast_add_vm_test needs NAME and COMMAND")
   endif()
@@ -58,6 +62,10 @@ function(agnocast_add_vm_test)
   foreach(file IN LISTS arg_OWN_FILES)
     get_filename_component(file "${file}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
     string(APPEND lines "file\t${file}\t${arg_NAME}\n")
+  endforeach()
+  foreach(tree IN LISTS arg_TREES)
+    string(REPLACE "|" "\t" tree "${tree}")
+    string(APPEND lines "tree\t${tree}\n")
   endforeach()
   string(APPEND lines "test\t${arg_NAME}\t${arg_TIMEOUT}\t${program_name} ${args}\n")
   set_property(GLOBAL APPEND_STRING PROPERTY AGNOCAST_VM_MANIFEST "${lines}")

@@ -1,11 +1,16 @@
 # agnocast_generate_messages(<target> PACKAGE <package> FILES <file.msg>...
-#                            [DEPENDENCIES <package or target>...])
+#                            [DEPENDENCIES <package or target>...] [PYTHON])
 #
 # Generates <package>/msg/<snake_case>.hpp for each .msg file and makes <target>,
 # an INTERFACE library to link: it carries the include folder, agnocast::agnocast
 # and the targets of the dependencies. The FILES of one package live in one folder.
 # A dependency is a target made by this function, or a package of the standard
 # set (std_msgs, geometry_msgs, sensor_msgs, nav_msgs, ...: agnocast::<name>).
+# PYTHON also makes <target>_python, which writes the Python message module
+# <dir>/agnocast/msg/<package>.py (see AgnocastPythonMessages.cmake); <dir> is
+# the target's property AGNOCAST_PYTHON_DIR, for PYTHONPATH or installation.
+
+include(${CMAKE_CURRENT_LIST_DIR}/AgnocastPythonMessages.cmake)
 
 # "PointCloud2" -> "point_cloud2", the rule of agnocast-msggen's snake_case().
 function(_agnocast_snake_case name out)
@@ -16,7 +21,7 @@ function(_agnocast_snake_case name out)
 endfunction()
 
 function(agnocast_generate_messages target)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "" "PACKAGE" "FILES;DEPENDENCIES")
+  cmake_parse_arguments(PARSE_ARGV 1 arg "PYTHON" "PACKAGE" "FILES;DEPENDENCIES")
   if(NOT arg_PACKAGE OR NOT arg_FILES)
     message(FATAL_ERROR "agnocast_generate_messages(${target}): PACKAGE and FILES are required")
   endif()
@@ -80,5 +85,10 @@ function(agnocast_generate_messages target)
   set_target_properties(${target} PROPERTIES
     AGNOCAST_MSG_INCLUDES "${includes}"
     AGNOCAST_PACKAGE ${arg_PACKAGE}
+    AGNOCAST_MSG_FILES "${inputs}"
     AGNOCAST_HEADER_DIR ${output_dir})
+  if(arg_PYTHON)
+    agnocast_python_messages(${target}_python OUTPUT_DIR ${output_dir}/python PACKAGES ${target})
+    set_target_properties(${target} PROPERTIES AGNOCAST_PYTHON_DIR ${output_dir}/python)
+  endif()
 endfunction()

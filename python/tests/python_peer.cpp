@@ -1,0 +1,140 @@
+// The C++ side of the Python interop tests: publishes or subscribes one typed
+// topic and prints what it sent or received, one line per message, so the
+// Python test can compare (contents, and the pool address of an array).
+//
+// usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]
+//   pub: waits for a subscriber, then publishes COUNT messages 100 ms apart
+//        (cloud: SIZE bytes of data, byte i = (i + seq) % 251), then waits
+//        for the end of stdin
+//   sub: prints each message until COUNT arrived, exits 0 (1 after 60 s)
+#include <agnocast/agnocast.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <geometry_msgs/msg/vector3.hpp>
+#include <sensor_msgs/msg/point_cloud2.hpp>
+#include <std_msgs/msg/string.hpp>
+#include <string>
+#include <thread>
+#include <wheel_msgs/msg/wheel.hpp>
+
+namespace {
+
+using namespace std::chrono_literals;
+
+void fill(std_msgs::msg::String& m, int seq) {
+  m.data = ("hello from C++ " + std::to_string(seq)).c_str();
+}
+void fill(sensor_msgs::msg::PointCloud2& m, int seq, std::size_t size) {
+  m.header.frame_id = "lidar";
+  m.header.stamp.sec = seq;
+  m.height = 1;
+  m.width = static_cast<std::uint32_t>(size / 16);
+  m.point_step = 16;
+  m.row_step = m.width * 16;
+  // Built aside and appended: assigning to a resized element's string draws
+  // a false -Wrestrict from GCC 12 at -O3.
+  sensor_msgs::msg::PointField x;
+  x.name = "x";
+  x.offset = 0;
+  x.datatype = 7;
+  x.count = 1;
+  m.fields.push_back(x);
+  m.data.resize(size);
+  for (std::size_t i = 0; i < size; ++i) m.data[i] = static_cast<std::uint8_t>((i + seq) % 251);
+}
+void fill(wheel_msgs::msg::Wheel& m, int seq) {
+  m.header.frame_id = "wheel";
+  m.name = "front left";
+  m.speeds.resize(3);
+  for (int i = 0; i < 3; ++i) m.speeds[i] = seq + i * 0.5;
+  for (int i = 0; i < 4; ++i) m.torque[i] = -seq * 10 - i;
+  m.forces.resize(2);
+  m.forces[1].z = 9.81 * seq;
+  m.labels.emplace_back("a");
+  m.labels.emplace_back("long label beyond any small-string buffer");
+}
+
+void print(const std_msgs::msg::String& m) { std::printf("string %s\n", m.data.c_str()); }
+void print(const sensor_msgs::msg::PointCloud2& m) {
+  unsigned long long sum = 0;
+  for (const auto byte : m.data) sum += byte;
+  std::printf("cloud %s %d %u %zu %llu %s %u %p\n", m.header.frame_id.c_str(), m.header.stamp.sec,
+              m.width, m.data.size(), sum, m.fields.empty() ? "-" : m.fields[0].name.c_str(),
+              m.fields.empty() ? 0u : m.fields[0].offset, static_cast<const void*>(m.data.data()));
+}
+void print(const wheel_msgs::msg::Wheel& m) {
+  std::printf("wheel %s %s", m.header.frame_id.c_str(), m.name.c_str());
+  for (const double s : m.speeds) std::printf(" %g", s);
+  std::printf(" |");
+  for (const int t : m.torque) std::printf(" %d", t);
+  std::printf(" | %zu", m.forces.size());
+  for (const auto& f : m.forces) std::printf(" %g", f.z);
+  std::printf(" |");
+  for (const auto& l : m.labels) std::printf(" [%s]", l.c_str());
+  std::printf("\n");
+}
+
+template <class T>
+int run(bool publish, const std::string& topic, int count, std::size_t size) {
+  agnocast::Node node{"python_peer"};
+  if (publish) {
+    auto pub = node.create_publisher<T>(topic, agnocast::QoS{10});
+    if (!pub->wait_for_subscribers(1, 60s)) return 1;
+    for (int seq = 1; seq <= count; ++seq) {
+      auto m = pub->borrow_loaned_message();
+      if constexpr (std::is_same_v<T, sensor_msgs::msg::PointCloud2>) {
+        fill(*m, seq, size);
+      } else {
+        fill(*m, seq);
+      }
+      print(*m);
+      std::fflush(stdout);
+      pub->publish(std::move(m));
+      std::this_thread::sleep_for(100ms);
+    }
+    // Stay until stdin closes: the test decides when it is done with the messages.
+    while (std::getchar() != EOF) {
+    }
+    return 0;
+  }
+  int received = 0;
+  agnocast::SingleThreadedExecutor exec;
+  auto sub = node.create_subscription<T>(topic, agnocast::QoS{10}, [&](const T& m) {
+    print(m);
+    std::fflush(stdout);
+    if (++received >= count) exec.cancel();
+  });
+  std::printf("ready\n");
+  std::fflush(stdout);
+  exec.add_node(node);
+  std::thread watchdog([&] {
+    for (int i = 0; i < 600 && received < count; ++i) std::this_thread::sleep_for(100ms);
+    exec.cancel();
+  });
+  exec.spin();
+  watchdog.join();
+  return received >= count ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]\n");
+    return 2;
+  }
+  const bool publish = std::string(argv[1]) == "pub";
+  const std::string type = argv[2];
+  const int count = std::atoi(argv[4]);
+  const std::size_t size = argc > 5 ? std::strtoull(argv[5], nullptr, 10) : 1024;
+  try {
+    if (type == "string") return run<std_msgs::msg::String>(publish, argv[3], count, size);
+    if (type == "cloud") return run<sensor_msgs::msg::PointCloud2>(publish, argv[3], count, size);
+    if (type == "wheel") return run<wheel_msgs::msg::Wheel>(publish, argv[3], count, size);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "python_peer: %s\n", e.what());
+    return 1;
+  }
+  return 2;
+}

@@ -1,5 +1,6 @@
-// What the in-VM C++ tests share: files, child processes run as other users,
-// polling for a condition, and the test bed's agnocast group.
+// What the in-VM C++ tests share (the components' tests and the kernel
+// module's): files, child processes run as other users, polling for a
+// condition, and the test bed's agnocast group.
 #pragma once
 
 #include <fcntl.h>
@@ -41,12 +42,16 @@ struct Identity {
   std::vector<gid_t> groups;
 };
 
+// Becomes uid with primary group gid and the supplementary groups (in a
+// forked child: there is no way back); false when that fails.
+inline bool become(uid_t uid, gid_t gid, const std::vector<gid_t>& groups = {}) {
+  return ::setgroups(groups.size(), groups.data()) == 0 && ::setgid(gid) == 0 &&
+         ::setuid(uid) == 0;
+}
+
 // In a forked child: become `who`; exits 126 when that fails.
 inline void become(const Identity& who) {
-  if (::setgroups(who.groups.size(), who.groups.data()) != 0 || ::setgid(who.gid) != 0 ||
-      ::setuid(who.uid) != 0) {
-    ::_exit(126);
-  }
+  if (!become(who.uid, who.gid, who.groups)) ::_exit(126);
 }
 
 // Runs args[0] from PATH with stdout and stderr into `log` (created before
@@ -75,6 +80,14 @@ inline int wait_exit(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+// Runs fn in a forked child, whose exit status is what fn returns; that
+// status, or 128 + the signal that ended it.
+inline int in_child(const std::function<int()>& fn) {
+  const pid_t pid = ::fork();
+  if (pid == 0) ::_exit(fn());
+  return wait_exit(pid);
+}
+
 // Ends a child that may be stopped (SIGCONT, SIGTERM, reaped); pid becomes -1.
 inline void stop(pid_t& pid) {
   if (pid <= 0) return;
@@ -84,12 +97,14 @@ inline void stop(pid_t& pid) {
   pid = -1;
 }
 
-// Polls `condition` every 50 ms until it holds (true) or `limit` passed (false).
-inline bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit) {
+// Polls `condition` every `poll` until it holds (true) or `limit` passed
+// (false).
+inline bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit,
+                       std::chrono::milliseconds poll = std::chrono::milliseconds(50)) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
   while (!condition()) {
     if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(poll);
   }
   return true;
 }

@@ -45,8 +45,7 @@ struct Identity {
 // Becomes uid with primary group gid and the supplementary groups (in a
 // forked child: there is no way back); false when that fails.
 inline bool become(uid_t uid, gid_t gid, const std::vector<gid_t>& groups = {}) {
-  return ::setgroups(groups.size(), groups.data()) == 0 && ::setgid(gid) == 0 &&
-         ::setuid(uid) == 0;
+  return ::setgroups(groups.size(), groups.data()) == 0 && ::setgid(gid) == 0 && ::setuid(uid) == 0;
 }
 
 // In a forked child: become `who`; exits 126 when that fails.

@@ -53,15 +53,18 @@ inline void become(const Identity& who) {
   if (!become(who.uid, who.gid, who.groups)) ::_exit(126);
 }
 
-// Runs args[0] from PATH with stdout and stderr into `log` (created before
-// becoming `who`, when given); exit status 127 when it cannot be run.
-inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
-                   const Identity* who = nullptr) {
+// Runs args[0] from PATH with stdout into `out` and stderr into `err` (the
+// same file when they are equal; created before becoming `who`, when
+// given); exit status 127 when it cannot be run.
+inline pid_t spawn(const std::vector<std::string>& args, const std::string& out,
+                   const std::string& err, const Identity* who = nullptr) {
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
+    const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err_fd =
+        err == out ? out_fd : ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out_fd, STDOUT_FILENO);
+    ::dup2(err_fd, STDERR_FILENO);
     if (who) become(*who);
     std::vector<char*> argv;
     for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
@@ -72,11 +75,36 @@ inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
   return pid;
 }
 
+// Runs args[0] from PATH with stdout and stderr into `log`.
+inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
+                   const Identity* who = nullptr) {
+  return spawn(args, log, log, who);
+}
+
 // The exit status, or 128 + the signal that ended it.
 inline int wait_exit(pid_t pid) {
   int status = 0;
   ::waitpid(pid, &status, 0);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// How a command ended and what it printed.
+struct Outcome {
+  int code = -1;  // its exit status; -1 when a signal ended it
+  std::string out;
+  std::string err;
+};
+
+// Runs `command` through /bin/sh (as `who`, when given) with stdout and
+// stderr into `stem`.out and `stem`.err, and waits for it.
+inline Outcome run_shell(const std::string& command, const std::string& stem,
+                         const Identity* who = nullptr) {
+  const std::string out = stem + ".out";
+  const std::string err = stem + ".err";
+  const pid_t pid = spawn({"/bin/sh", "-c", command}, out, err, who);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
 
 // Runs fn in a forked child, whose exit status is what fn returns; that

@@ -1,14 +1,15 @@
 #include "bridge.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
+#include <signal.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdio>
+#include <cstring>
 #include <ctime>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -18,28 +19,30 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/executor.hpp"
 #include "agnocast/inspect.hpp"
-#include "agnocast/signals.hpp"
 #include "agnocast/version.hpp"
+#include "agnocast_service/instance_lock.hpp"
+#include "agnocast_service/journal_log.hpp"
+#include "agnocast_service/notify.hpp"
+#include "agnocast_service/signals.hpp"
+#include "agnocast_service/timer.hpp"
+#include "agnocast_service/watchdog.hpp"
 #include "config.hpp"
 #include "dds_domain.hpp"
-#include "notify.hpp"
 #include "status_file.hpp"
 
 namespace agnocast_bridge {
 namespace {
 
 constexpr const char* node_name = "agnocast_bridge";
-constexpr auto status_interval = std::chrono::seconds(1);
+constexpr int exit_failure = 1;
+constexpr int exit_usage = 2;  // a bad command line or configuration
 
-void print_usage(std::ostream& out) {
-  out << "usage: agnocast-bridge [--config PATH] [--check-config] [--list-types] [--version]\n"
-         "Relays agnocast topics to and from DDS (Cyclone DDS) as ROS 2 does.\n"
-         "  --config PATH    configuration (default "
-      << default_config_path
-      << ")\n"
-         "  --check-config   validate the configuration and exit (0 valid, 2 not)\n"
-         "  --list-types     print the message types this bridge knows\n";
-}
+// The signals that stop the bridge; any other keeps its default action.
+sigset_t stop_signals() { return agnocast_service::signal_set({SIGTERM, SIGINT}); }
+constexpr auto status_interval = std::chrono::seconds(1);
+// How long the DDS receiver waits before it turns its loop again when no
+// sample comes: it proves it is alive at least this often.
+constexpr auto receiver_turn = std::chrono::seconds(1);
 
 // Bridged topics whose type is not in the registry are configuration errors.
 void check_types(const Config& config, const TypeRegistry& types) {
@@ -53,31 +56,6 @@ void check_types(const Config& config, const TypeRegistry& types) {
                           "agnocast_add_bridge())");
   }
 }
-
-// One bridge per machine: its loop protection recognizes only its own
-// process's publications, and two bridges would relay each other's.
-class InstanceLock {
- public:
-  explicit InstanceLock(const std::string& path) {
-    std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0 || ::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      throw std::runtime_error("another agnocast-bridge is running (it holds " + path + ")");
-    }
-    const std::string pid = std::to_string(::getpid()) + "\n";
-    if (::ftruncate(fd_, 0) != 0 || ::write(fd_, pid.data(), pid.size()) < 0) {
-      throw std::runtime_error("cannot write " + path);
-    }
-  }
-  ~InstanceLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  InstanceLock(const InstanceLock&) = delete;
-  InstanceLock& operator=(const InstanceLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
 
 struct BridgedTopic {
   const TopicConfig* config;
@@ -109,12 +87,23 @@ class DdsReceiver {
   DdsReceiver(const DdsReceiver&) = delete;
   DdsReceiver& operator=(const DdsReceiver&) = delete;
 
+  // True when its loop turned within `limit` (or it has no reader to serve):
+  // a receiver stuck in a relay for longer is not alive.
+  bool alive(std::chrono::steady_clock::duration limit) const {
+    if (!thread_.joinable()) return true;
+    const auto last = std::chrono::steady_clock::time_point(
+        std::chrono::steady_clock::duration(last_turn_.load()));
+    return std::chrono::steady_clock::now() - last <= limit;
+  }
+
  private:
   void run() {
     std::vector<dds_attach_t> triggered(relays_.size() + 1);
     while (!stopping_) {
+      last_turn_ = std::chrono::steady_clock::now().time_since_epoch().count();
       const dds_return_t count =
-          dds_waitset_wait(waitset_.get(), triggered.data(), triggered.size(), DDS_SECS(1));
+          dds_waitset_wait(waitset_.get(), triggered.data(), triggered.size(),
+                           std::chrono::nanoseconds(receiver_turn).count());
       for (dds_return_t i = 0; i < count; ++i) {
         if (triggered[i] > 0) relays_[triggered[i] - 1]->relay_available();
       }
@@ -125,6 +114,8 @@ class DdsReceiver {
   DdsEntity stop_;
   std::vector<Relay*> relays_;
   std::atomic<bool> stopping_{false};
+  std::atomic<std::chrono::steady_clock::rep> last_turn_{
+      std::chrono::steady_clock::now().time_since_epoch().count()};
   std::thread thread_;
 };
 
@@ -180,14 +171,15 @@ void write_status(const Config& config, const std::vector<BridgedTopic>& topics,
     write_status_file(std::string(status_path),
                       collect_status(config, topics, started_at, running));
   } catch (const std::exception& error) {
-    std::cerr << "agnocast-bridge: status file: " << error.what() << std::endl;
+    spdlog::error("status file: {}", error.what());
   }
 }
 
 int serve(const Config& config, const TypeRegistry& types) {
   DdsDomain domain(config.domain_id);
-  const InstanceLock lock{std::string(lock_path)};
-  agnocast::install_signal_handlers();
+  // One bridge per machine: its loop protection recognizes only its own
+  // process's publications, and two bridges would relay each other's.
+  const agnocast_service::InstanceLock lock{std::string(lock_path), "agnocast-bridge"};
   const auto started_at = static_cast<std::int64_t>(std::time(nullptr));
 
   agnocast::Node node(node_name);
@@ -208,30 +200,42 @@ int serve(const Config& config, const TypeRegistry& types) {
     }
   }
 
+  // One loop: agnocast's subscriptions, the stop signals, the status file's
+  // timer and the watchdog's; DDS samples come on the receiver's thread.
   agnocast::SingleThreadedExecutor executor;
   executor.add_node(node);
   const DdsReceiver receiver(domain, topics);
-  write_status(config, topics, started_at, true);
-  std::cerr << "agnocast-bridge: relaying " << topics.size() << " topic(s) on DDS domain "
-            << config.domain_id << std::endl;
-  notify_systemd("READY=1");
+  agnocast_service::SignalFd signals(stop_signals());
+  executor.add_fd(signals.fd(), [&signals, &executor] {
+    while (const auto signal = signals.read()) {
+      spdlog::info("received {}, stopping", strsignal(*signal));
+      executor.cancel();
+    }
+  });
+  agnocast_service::PeriodicTimer status_timer(status_interval);
+  executor.add_fd(status_timer.fd(), [&] {
+    status_timer.consume();
+    write_status(config, topics, started_at, true);
+  });
+  // Pinged from this loop, and only while the receiver's loop turns too.
+  agnocast_service::Watchdog watchdog;
+  const auto receiver_limit = std::max<std::chrono::steady_clock::duration>(
+      watchdog.interval().value_or(std::chrono::microseconds{0}), 2 * receiver_turn);
+  executor.add_fd(watchdog.fd(), [&] {
+    const bool alive = receiver.alive(receiver_limit);
+    watchdog.tick(alive);
+    if (!alive) spdlog::error("the DDS receiver is stuck; not pinging the watchdog");
+  });
 
-  const auto watchdog = watchdog_interval();
-  auto next_status = std::chrono::steady_clock::now() + status_interval;
-  auto next_watchdog = std::chrono::steady_clock::now();
-  while (agnocast::ok()) {
-    executor.spin_once(std::chrono::milliseconds(100));
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= next_status) {
-      write_status(config, topics, started_at, true);
-      next_status = now + status_interval;
-    }
-    if (watchdog && now >= next_watchdog) {
-      notify_systemd("WATCHDOG=1");
-      next_watchdog = now + *watchdog;
-    }
-  }
-  notify_systemd("STOPPING=1");
+  write_status(config, topics, started_at, true);
+  spdlog::info("relaying {} topic(s) on DDS domain {}", topics.size(), config.domain_id);
+  agnocast_service::notify("READY=1\nSTATUS=relaying " + std::to_string(topics.size()) +
+                           " topic(s) on DDS domain " + std::to_string(config.domain_id));
+  executor.spin();
+  agnocast_service::notify("STOPPING=1");
+  executor.remove_fd(watchdog.fd());
+  executor.remove_fd(status_timer.fd());
+  executor.remove_fd(signals.fd());
   write_status(config, topics, started_at, false);
   return 0;
 }
@@ -239,56 +243,54 @@ int serve(const Config& config, const TypeRegistry& types) {
 }  // namespace
 
 int run_bridge(int argc, char** argv, const TypeRegistry& types) {
+  CLI::App app{"Relays agnocast topics to and from DDS (Cyclone DDS) as ROS 2 does.",
+               "agnocast-bridge"};
   std::string config_path(default_config_path);
   bool check_only = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "--config" && i + 1 < argc) {
-      config_path = argv[++i];
-    } else if (argument == "--check-config") {
-      check_only = true;
-    } else if (argument == "--list-types") {
-      for (const auto& name : types.type_names()) std::cout << name << '\n';
-      return 0;
-    } else if (argument == "--version") {
-      std::cout << "agnocast-bridge " << agnocast::library_version_string << '\n';
-      return 0;
-    } else if (argument == "--help" || argument == "-h") {
-      print_usage(std::cout);
-      return 0;
-    } else {
-      std::cerr << "agnocast-bridge: unknown argument '" << argument << "'\n";
-      print_usage(std::cerr);
-      return 2;
-    }
+  bool list_types = false;
+  app.add_option("--config", config_path, "Configuration file")->capture_default_str();
+  app.add_flag("--check-config", check_only,
+               "Validate the configuration and exit (0 valid, 2 not)");
+  app.add_flag("--list-types", list_types, "Print the message types this bridge knows");
+  app.set_version_flag("--version",
+                       "agnocast-bridge " + std::string(agnocast::library_version_string));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error) == EXIT_SUCCESS ? EXIT_SUCCESS : exit_usage;  // --help is no error
+  }
+  if (list_types) {
+    for (const auto& name : types.type_names()) std::cout << name << '\n';
+    return EXIT_SUCCESS;
   }
 
+  agnocast_service::set_up_logging("agnocast-bridge", "info", agnocast_service::stderr_is_journal(),
+                                   agnocast_service::LogStyle::tagged);
   Config config;
   try {
     config = load_config(config_path);
     check_types(config, types);
   } catch (const ConfigError& error) {
-    std::cerr << "agnocast-bridge: bad configuration " << config_path << ": " << error.what()
-              << std::endl;
-    return 2;
+    spdlog::error("bad configuration {}: {}", config_path, error.what());
+    return exit_usage;
   }
   if (check_only) {
     std::cout << "agnocast-bridge: " << config_path << " is valid (" << config.topics.size()
               << " topic(s))\n";
-    return 0;
+    return EXIT_SUCCESS;
   }
   try {
+    // Stop signals queue for the serve loop from here on, before any thread
+    // (Cyclone DDS's) starts: every thread inherits the mask.
+    agnocast_service::block_signals(stop_signals());
     return serve(config, types);
   } catch (const ConfigError& error) {
-    std::cerr << "agnocast-bridge: bad configuration " << config_path << ": " << error.what()
-              << std::endl;
-    return 2;
-  } catch (const DdsError& error) {
-    std::cerr << "agnocast-bridge: " << error.what() << std::endl;
+    spdlog::error("bad configuration {}: {}", config_path, error.what());
+    return exit_usage;
   } catch (const std::exception& error) {
-    std::cerr << "agnocast-bridge: " << error.what() << std::endl;
+    spdlog::error("{}", error.what());
   }
-  return 1;
+  return exit_failure;
 }
 
 }  // namespace agnocast_bridge

@@ -1,13 +1,8 @@
 #include "status_file.hpp"
 
-#include <sys/stat.h>
-
-#include <cerrno>
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <system_error>
 
+#include "agnocast_service/atomic_file.hpp"
 #include "dds_names.hpp"
 
 namespace agnocast_bridge {
@@ -32,18 +27,7 @@ std::string status_json(const BridgeStatus& status) {
 }
 
 void write_status_file(const std::string& path, const BridgeStatus& status) {
-  const std::filesystem::path target(path);
-  if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream file(temporary, std::ios::trunc);
-    file << status_json(status) << '\n';
-    if (!file.flush()) {
-      throw std::system_error(errno, std::generic_category(), "cannot write " + temporary);
-    }
-  }
-  ::chmod(temporary.c_str(), 0644);
-  std::filesystem::rename(temporary, target);
+  agnocast_service::write_file_atomically(path, status_json(status) + "\n");
 }
 
 }  // namespace agnocast_bridge

@@ -1,4 +1,4 @@
-// The bridge's status file, one JSON object replaced atomically (rename), 0644:
+// The bridge's status file, one JSON object replaced atomically, 0644:
 //   {"running":true,"pid":42,"domain_id":0,"started_at":1700000000,"uptime_s":12,
 //    "topics":[{"name":"/points","type":"sensor_msgs/msg/PointCloud2",
 //               "direction":"to_dds","dds_topic":"rt/points",
@@ -36,7 +36,8 @@ struct BridgeStatus {
 };
 
 std::string status_json(const BridgeStatus& status);
-// Throws std::system_error when the file cannot be written.
+// Replaces path (agnocast_service::write_file_atomically); throws
+// std::system_error when the file cannot be written.
 void write_status_file(const std::string& path, const BridgeStatus& status);
 
 }  // namespace agnocast_bridge

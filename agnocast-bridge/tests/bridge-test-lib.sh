@@ -3,6 +3,7 @@
 # the bridge and the DDS peer (a separate process, as on another machine)
 # discover each other as Cyclone DDS does on a real network.
 set -u
+. /opt/agnocast/bin/vm-test-lib.sh
 status_file=/run/agnocast/bridge.json
 bridge_pid=
 helpers=
@@ -16,19 +17,6 @@ fail() {
 	[ -n "$bridge_pid" ] && kill -9 "$bridge_pid" 2>/dev/null
 	for pid in $helpers; do kill -9 "$pid" 2>/dev/null; done
 	exit 1
-}
-
-now_cs() { sed 's/^\([0-9]*\)\.\([0-9]*\) .*/\1\2/' /proc/uptime; }
-
-# wait_until SECONDS COMMAND...: polls COMMAND every 50 ms; false after SECONDS.
-wait_until() {
-	limit_cs=$(($1 * 100)); shift
-	start_cs=$(now_cs)
-	while ! "$@"; do
-		[ $(($(now_cs) - start_cs)) -ge "$limit_cs" ] && return 1
-		sleep 0.05
-	done
-	return 0
 }
 
 setup_dds_network() {

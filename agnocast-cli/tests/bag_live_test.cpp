@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <agnocast/agnocast.hpp>
+#include <agnocast_test/process.hpp>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -48,46 +49,19 @@ using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
+using agnocast_test::Outcome;
+using agnocast_test::slurp;
+using agnocast_test::wait_exit;
 
 Outcome cli(const std::string& args) {
-  const std::string command = "agnocast-cli " + args + " >bag.out 2>bag.err";
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp("bag.out"), slurp("bag.err")};
+  return agnocast_test::run_shell("agnocast-cli " + args, "bag");
 }
 
 // agnocast-cli bag record ARGS... in the background.
 pid_t start_recorder(const std::vector<std::string>& args) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int out = ::open("record.out", O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err = ::open("record.err", O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(out, STDOUT_FILENO);
-    ::dup2(err, STDERR_FILENO);
-    std::vector<const char*> argv{"agnocast-cli", "bag", "record"};
-    for (const std::string& arg : args) argv.push_back(arg.c_str());
-    argv.push_back(nullptr);
-    ::execvp("agnocast-cli", const_cast<char* const*>(argv.data()));
-    ::_exit(127);
-  }
-  return pid;
-}
-
-int wait_exit(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::vector<std::string> argv{"agnocast-cli", "bag", "record"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return agnocast_test::spawn(argv, "record.out", "record.err");
 }
 
 template <class T>

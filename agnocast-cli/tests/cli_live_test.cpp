@@ -31,29 +31,16 @@ using agnocast_test::stop;
 using agnocast_test::vm_agnocast_gid;
 using nlohmann::json;
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
+struct Outcome : agnocast_test::Outcome {
   json value() const { return json::parse(out); }
 };
 
 // Runs agnocast-cli ARGS through sh, as root or, with `uid`, as that user
 // with only the supplementary `groups`.
 Outcome cli(const std::string& args, uid_t uid = 0, const std::vector<gid_t>& groups = {}) {
-  const std::string out = "cli-" + std::to_string(uid) + ".out";
-  const std::string err = "cli-" + std::to_string(uid) + ".err";
-  const std::string command = "agnocast-cli " + args + " >" + out + " 2>" + err;
   const agnocast_test::Identity who{uid, uid, groups};
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    if (uid != 0) become(who);
-    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  return {agnocast_test::run_shell("agnocast-cli " + args, "cli-" + std::to_string(uid),
+                                   uid != 0 ? &who : nullptr)};
 }
 
 // Under TCG the daemon and the endpoints take seconds to come up.

@@ -50,16 +50,10 @@ namespace {
 using agnocast_test::slurp;
 using nlohmann::json;
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
+using agnocast_test::Outcome;
 
 Outcome cli(const std::string& args) {
-  const std::string command = "agnocast-cli " + args + " >echo.out 2>echo.err";
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp("echo.out"), slurp("echo.err")};
+  return agnocast_test::run_shell("agnocast-cli " + args, "echo");
 }
 
 std::vector<json> json_lines(const std::string& text) {

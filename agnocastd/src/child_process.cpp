@@ -10,12 +10,14 @@
 #include <chrono>
 #include <system_error>
 
+#include "agnocast_service/errno_error.hpp"
 #include "daemon_signals.hpp"
-#include "errno_error.hpp"
 
 extern char** environ;
 
 namespace agnocastd {
+
+using agnocast_service::throw_errno;
 namespace {
 
 // posix_spawn attributes and file actions, released when the scope ends.

@@ -2,43 +2,20 @@
 
 #include <spdlog/spdlog.h>
 
-#include <cerrno>
 #include <cstring>
 
-#include "errno_error.hpp"
+#include "agnocast_service/signals.hpp"
 
 namespace agnocastd {
 
-sigset_t daemon_signals() {
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGHUP);
-  return signals;
-}
+sigset_t daemon_signals() { return agnocast_service::signal_set({SIGTERM, SIGINT, SIGHUP}); }
 
-void block_daemon_signals() {
-  const sigset_t signals = daemon_signals();
-  if (::sigprocmask(SIG_BLOCK, &signals, nullptr) != 0) throw_errno("sigprocmask");
-}
+void block_daemon_signals() { agnocast_service::block_signals(daemon_signals()); }
 
 bool stop_requested(std::chrono::milliseconds wait) {
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
-  const auto nanoseconds = std::chrono::nanoseconds(wait).count();
-  const timespec timeout{static_cast<time_t>(nanoseconds / 1'000'000'000),
-                         static_cast<long>(nanoseconds % 1'000'000'000)};
-  int signal = -1;
-  do {
-    signal = ::sigtimedwait(&stop_signals, nullptr, &timeout);
-  } while (signal < 0 && errno == EINTR);
-  if (signal < 0) {
-    if (errno != EAGAIN) throw_errno("sigtimedwait");
-    return false;
-  }
+  const int signal =
+      agnocast_service::wait_for_signal(agnocast_service::signal_set({SIGTERM, SIGINT}), wait);
+  if (signal == 0) return false;
   spdlog::info("received {} while starting, stopping", strsignal(signal));
   return true;
 }

@@ -11,16 +11,16 @@
 #include "agnocast/inspect.hpp"
 #include "agnocast/status.hpp"
 #include "agnocast/supervise.hpp"
+#include "agnocast_service/instance_lock.hpp"
+#include "agnocast_service/journal_log.hpp"
+#include "agnocast_service/notify.hpp"
 #include "config.hpp"
 #include "daemon_signals.hpp"
 #include "event_loop.hpp"
 #include "host.hpp"
-#include "instance_lock.hpp"
-#include "journal_log.hpp"
 #include "module_loader.hpp"
 #include "module_parameters.hpp"
 #include "mqueue_setup.hpp"
-#include "notify.hpp"
 #include "reload.hpp"
 #include "sweeper.hpp"
 
@@ -120,7 +120,7 @@ void stop_module(bool loaded_here, bool unload_on_exit) {
 
 int run(const agnocastd::Config& config, std::function<agnocastd::Config()> reread_config) {
   // One daemon at a time, before touching anything.
-  agnocastd::InstanceLock lock{std::string(agnocast::daemon_lock_path)};
+  const agnocast_service::InstanceLock lock{std::string(agnocast::daemon_lock_path), "agnocastd"};
   // Stop signals queue up from here on; serve() reads them.
   agnocastd::block_daemon_signals();
   // The module, its version and the device permissions: clients need all three.
@@ -151,7 +151,7 @@ int run(const agnocastd::Config& config, std::function<agnocastd::Config()> rere
     agnocastd::clean_exited_processes(supervisor);
     agnocastd::sweep(host, supervisor.counters);
     agnocastd::write_status(supervisor, /*running=*/true);
-    agnocastd::notify("READY=1");
+    agnocast_service::notify("READY=1");
     spdlog::info("agnocastd {} ready", agnocast::library_version_string);
     try {
       agnocastd::serve(supervisor);
@@ -159,7 +159,7 @@ int run(const agnocastd::Config& config, std::function<agnocastd::Config()> rere
       agnocastd::write_status(supervisor, /*running=*/false);
       throw;
     }
-    agnocastd::notify("STOPPING=1");
+    agnocast_service::notify("STOPPING=1");
     // Exits that raced the stop signal: nothing is left behind for the next start.
     agnocastd::clean_exited_processes(supervisor);
     agnocastd::write_status(supervisor, /*running=*/false);
@@ -192,7 +192,8 @@ int main(int argc, char** argv) {
   }
 
   // Before the configuration: reading it may log.
-  agnocastd::set_up_logging(options.log_level.value_or("info"), agnocastd::stderr_is_journal());
+  agnocast_service::set_up_logging("agnocastd", options.log_level.value_or("info"),
+                                   agnocast_service::stderr_is_journal());
   const bool config_given = app.count("--config") > 0;
   agnocastd::Config config;
   try {

@@ -12,9 +12,11 @@
 #include <system_error>
 
 #include "agnocast/naming.hpp"
-#include "errno_error.hpp"
+#include "agnocast_service/errno_error.hpp"
 
 namespace agnocastd {
+
+using agnocast_service::throw_errno;
 
 namespace {
 

@@ -1,18 +1,13 @@
 #!/bin/sh
 # The PointCloud2 pipeline across three processes: driver -> filter -> consumer.
 set -eu
+. /opt/agnocast/bin/vm-test-lib.sh
 raw=/examples/points_raw_$$
 filtered=/examples/points_filtered_$$
 
 # Waits until a subscriber's queue for topic $1 exists.
 wait_for_subscriber() {
-  mangled=$(echo "$1" | cut -c2- | tr / _)
-  tries=0
-  until ls /dev/mqueue | grep -q "^$mangled@"; do
-    tries=$((tries + 1))
-    [ "$tries" -lt 200 ] || { echo "nobody subscribed to $1"; exit 1; }
-    sleep 0.05
-  done
+  wait_until 10 topic_queued "$1" || { echo "nobody subscribed to $1"; exit 1; }
 }
 
 agnocast-pointcloud-consumer --topic "$filtered" --count 10 --timeout 60 \

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <agnocast.h>
+#include <agnocast_test/process.hpp>
 #include <fcntl.h>
 #include <grp.h>
 #include <gtest/gtest.h>
@@ -24,7 +25,7 @@
 
 namespace agnocast_test {
 
-inline constexpr gid_t kAgnocastGroup = 990;  // the VM's group agnocast, given the device
+inline constexpr gid_t kAgnocastGroup = vm_agnocast_gid;  // the VM's group agnocast, given the device
 inline constexpr uid_t kNobody = 65534;
 
 inline constexpr uint8_t kPoison = 0xA5;
@@ -273,11 +274,7 @@ inline bool process_listed(int dev, pid_t pid)
 // Polls cond every 10 ms for up to timeout_ms (teardown runs asynchronously).
 inline bool eventually(const std::function<bool()> &cond, int timeout_ms = 10000)
 {
-  for (int waited = 0; waited < timeout_ms; waited += 10) {
-    if (cond()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return cond();
+  return eventually(cond, std::chrono::milliseconds(timeout_ms), std::chrono::milliseconds(10));
 }
 
 // Every exit record waiting now (non-blocking).
@@ -294,22 +291,6 @@ inline std::vector<agnocast_exit_record> drain_exit_records(int dev)
   close(fd);
   (void)dev;
   return out;
-}
-
-// Runs fn in a forked child; returns its exit status (or 128+signal).
-inline int in_child(const std::function<int()> &fn)
-{
-  pid_t pid = fork();
-  if (pid == 0) _exit(fn());
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return WEXITSTATUS(status);
-}
-
-// Becomes @uid with primary group @gid and the supplementary @groups.
-inline bool become(uid_t uid, gid_t gid, std::vector<gid_t> groups = {}) {
-  return setgroups(groups.size(), groups.data()) == 0 && setgid(gid) == 0 && setuid(uid) == 0;
 }
 
 // Policy helpers: one rule with its publish and subscribe principals.

@@ -16,3 +16,9 @@ wait_until() {
 	waited_ms=$((($(now_cs) - start_cs) * 10))
 	return 0
 }
+
+# topic_queued TOPIC: a subscriber's notification queue for TOPIC exists
+# (/a/b's are /dev/mqueue/a_b@<id>), i.e. someone subscribed to it.
+topic_queued() {
+	ls /dev/mqueue | grep -q "^$(echo "$1" | cut -c2- | tr / _)@"
+}

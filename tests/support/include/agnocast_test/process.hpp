@@ -1,5 +1,6 @@
-// What the in-VM C++ tests share: files, child processes run as other users,
-// polling for a condition, and the test bed's agnocast group.
+// What the in-VM C++ tests share (the components' tests and the kernel
+// module's): files, child processes run as other users, polling for a
+// condition, and the test bed's agnocast group.
 #pragma once
 
 #include <fcntl.h>
@@ -41,23 +42,29 @@ struct Identity {
   std::vector<gid_t> groups;
 };
 
-// In a forked child: become `who`; exits 126 when that fails.
-inline void become(const Identity& who) {
-  if (::setgroups(who.groups.size(), who.groups.data()) != 0 || ::setgid(who.gid) != 0 ||
-      ::setuid(who.uid) != 0) {
-    ::_exit(126);
-  }
+// Becomes uid with primary group gid and the supplementary groups (in a
+// forked child: there is no way back); false when that fails.
+inline bool become(uid_t uid, gid_t gid, const std::vector<gid_t>& groups = {}) {
+  return ::setgroups(groups.size(), groups.data()) == 0 && ::setgid(gid) == 0 && ::setuid(uid) == 0;
 }
 
-// Runs args[0] from PATH with stdout and stderr into `log` (created before
-// becoming `who`, when given); exit status 127 when it cannot be run.
-inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
-                   const Identity* who = nullptr) {
+// In a forked child: become `who`; exits 126 when that fails.
+inline void become(const Identity& who) {
+  if (!become(who.uid, who.gid, who.groups)) ::_exit(126);
+}
+
+// Runs args[0] from PATH with stdout into `out` and stderr into `err` (the
+// same file when they are equal; created before becoming `who`, when
+// given); exit status 127 when it cannot be run.
+inline pid_t spawn(const std::vector<std::string>& args, const std::string& out,
+                   const std::string& err, const Identity* who = nullptr) {
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
+    const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err_fd =
+        err == out ? out_fd : ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out_fd, STDOUT_FILENO);
+    ::dup2(err_fd, STDERR_FILENO);
     if (who) become(*who);
     std::vector<char*> argv;
     for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
@@ -68,11 +75,44 @@ inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
   return pid;
 }
 
+// Runs args[0] from PATH with stdout and stderr into `log`.
+inline pid_t spawn(const std::vector<std::string>& args, const std::string& log,
+                   const Identity* who = nullptr) {
+  return spawn(args, log, log, who);
+}
+
 // The exit status, or 128 + the signal that ended it.
 inline int wait_exit(pid_t pid) {
   int status = 0;
   ::waitpid(pid, &status, 0);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// How a command ended and what it printed.
+struct Outcome {
+  int code = -1;  // its exit status; -1 when a signal ended it
+  std::string out;
+  std::string err;
+};
+
+// Runs `command` through /bin/sh (as `who`, when given) with stdout and
+// stderr into `stem`.out and `stem`.err, and waits for it.
+inline Outcome run_shell(const std::string& command, const std::string& stem,
+                         const Identity* who = nullptr) {
+  const std::string out = stem + ".out";
+  const std::string err = stem + ".err";
+  const pid_t pid = spawn({"/bin/sh", "-c", command}, out, err, who);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+// Runs fn in a forked child, whose exit status is what fn returns; that
+// status, or 128 + the signal that ended it.
+inline int in_child(const std::function<int()>& fn) {
+  const pid_t pid = ::fork();
+  if (pid == 0) ::_exit(fn());
+  return wait_exit(pid);
 }
 
 // Ends a child that may be stopped (SIGCONT, SIGTERM, reaped); pid becomes -1.
@@ -84,12 +124,14 @@ inline void stop(pid_t& pid) {
   pid = -1;
 }
 
-// Polls `condition` every 50 ms until it holds (true) or `limit` passed (false).
-inline bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit) {
+// Polls `condition` every `poll` until it holds (true) or `limit` passed
+// (false).
+inline bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds limit,
+                       std::chrono::milliseconds poll = std::chrono::milliseconds(50)) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
   while (!condition()) {
     if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(poll);
   }
   return true;
 }

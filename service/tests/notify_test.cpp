@@ -1,4 +1,4 @@
-#include "notify.hpp"
+#include "agnocast_service/notify.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/socket.h>
@@ -9,7 +9,7 @@
 #include <cstring>
 #include <string>
 
-namespace agnocastd {
+namespace agnocast_service {
 namespace {
 
 TEST(Notify, NoOpOutsideSystemd) {
@@ -18,7 +18,7 @@ TEST(Notify, NoOpOutsideSystemd) {
 }
 
 TEST(Notify, SendsOneDatagramToNotifySocket) {
-  const std::string path = ::testing::TempDir() + "/agnocastd-notify.sock";
+  const std::string path = ::testing::TempDir() + "/agnocast-service-notify.sock";
   ::unlink(path.c_str());
   const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
   ASSERT_GE(fd, 0);
@@ -51,4 +51,4 @@ TEST(Notify, WatchdogIntervalIsHalfOfWatchdogUsec) {
 }
 
 }  // namespace
-}  // namespace agnocastd
+}  // namespace agnocast_service

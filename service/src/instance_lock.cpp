@@ -1,23 +1,18 @@
-#include "instance_lock.hpp"
+#include "agnocast_service/instance_lock.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <filesystem>
-#include <string>
 #include <system_error>
 
-namespace agnocastd {
+#include "agnocast_service/atomic_file.hpp"
 
-InstanceLock::InstanceLock(const std::string& path) {
-  const std::filesystem::path lock(path);
-  if (lock.has_parent_path() && !std::filesystem::exists(lock.parent_path())) {
-    std::filesystem::create_directories(lock.parent_path());
-    ::chmod(lock.parent_path().c_str(), 0755);
-  }
+namespace agnocast_service {
+
+InstanceLock::InstanceLock(const std::string& path, const std::string& program) {
+  create_parent_directory(path);
   fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + path);
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
@@ -30,7 +25,7 @@ InstanceLock::InstanceLock(const std::string& path) {
     }
     std::string pid = length > 0 ? std::string(buffer, static_cast<std::size_t>(length)) : "?";
     while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
-    throw AlreadyRunning("agnocastd is already running (pid " + pid + ")");
+    throw AlreadyRunning(program + " is already running (pid " + pid + ")");
   }
   const std::string pid = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd_, 0) != 0 ||
@@ -43,4 +38,4 @@ InstanceLock::InstanceLock(const std::string& path) {
 
 InstanceLock::~InstanceLock() { ::close(fd_); }
 
-}  // namespace agnocastd
+}  // namespace agnocast_service

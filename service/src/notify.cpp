@@ -1,14 +1,14 @@
-#include "notify.hpp"
+#include "agnocast_service/notify.hpp"
 
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
-#include <string>
 
-namespace agnocastd {
+namespace agnocast_service {
 
 bool notify(std::string_view state) {
   const char* socket_path = std::getenv("NOTIFY_SOCKET");
@@ -43,4 +43,4 @@ std::optional<std::chrono::microseconds> watchdog_ping_interval() {
   return std::chrono::microseconds(value / 2);
 }
 
-}  // namespace agnocastd
+}  // namespace agnocast_service

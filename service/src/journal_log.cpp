@@ -1,4 +1,4 @@
-#include "journal_log.hpp"
+#include "agnocast_service/journal_log.hpp"
 
 #include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/stdout_sinks.h>
@@ -10,7 +10,7 @@
 #include <cstdlib>
 #include <memory>
 
-namespace agnocastd {
+namespace agnocast_service {
 namespace {
 
 // The "%*" pattern flag: "<N>", the record's syslog priority.
@@ -27,6 +27,16 @@ class SyslogPriorityFlag : public spdlog::custom_flag_formatter {
     return std::make_unique<SyslogPriorityFlag>();
   }
 };
+
+// A pattern that prints text as it is ('%' is the pattern's escape).
+std::string literal_pattern(const std::string& text) {
+  std::string pattern;
+  for (const char c : text) {
+    if (c == '%') pattern += '%';
+    pattern += c;
+  }
+  return pattern;
+}
 
 }  // namespace
 
@@ -56,20 +66,27 @@ int syslog_priority(spdlog::level::level_enum level) {
   }
 }
 
-std::unique_ptr<spdlog::formatter> log_formatter(bool to_journal) {
+std::unique_ptr<spdlog::formatter> log_formatter(bool to_journal, LogStyle style,
+                                                 const std::string& program) {
   auto formatter = std::make_unique<spdlog::pattern_formatter>();
-  // journald stamps each line itself and reads the priority from "<N>".
-  formatter->add_flag<SyslogPriorityFlag>('*').set_pattern(to_journal ? "%*%v"
-                                                                      : "[%Y-%m-%d %T.%e] [%l] %v");
+  // journald stamps each line itself, names the program and reads the
+  // priority from "<N>".
+  std::string pattern = "%*%v";
+  if (!to_journal) {
+    pattern =
+        style == LogStyle::tagged ? literal_pattern(program) + ": %v" : "[%Y-%m-%d %T.%e] [%l] %v";
+  }
+  formatter->add_flag<SyslogPriorityFlag>('*').set_pattern(pattern);
   return formatter;
 }
 
-void set_up_logging(const std::string& level, bool to_journal) {
-  auto logger = spdlog::stderr_logger_st("agnocastd");
-  logger->set_formatter(log_formatter(to_journal));
+void set_up_logging(const std::string& program, const std::string& level, bool to_journal,
+                    LogStyle style) {
+  auto logger = spdlog::stderr_logger_st(program);
+  logger->set_formatter(log_formatter(to_journal, style, program));
   logger->set_level(spdlog::level::from_str(level));
   logger->flush_on(spdlog::level::trace);
   spdlog::set_default_logger(logger);
 }
 
-}  // namespace agnocastd
+}  // namespace agnocast_service

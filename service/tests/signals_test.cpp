@@ -1,0 +1,112 @@
+#include "agnocast_service/signals.hpp"
+
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "agnocast_service/timer.hpp"
+#include "agnocast_service/watchdog.hpp"
+
+namespace agnocast_service {
+namespace {
+
+using namespace std::chrono_literals;
+
+bool readable(int fd, std::chrono::milliseconds wait) {
+  pollfd entry{fd, POLLIN, 0};
+  return ::poll(&entry, 1, static_cast<int>(wait.count())) == 1;
+}
+
+TEST(Signals, BlockedSignalsAreReadFromTheDescriptor) {
+  const sigset_t usr = signal_set({SIGUSR1, SIGUSR2});
+  block_signals(usr);
+  SignalFd signals(usr);
+  EXPECT_FALSE(signals.read());
+  ::raise(SIGUSR2);
+  ASSERT_TRUE(readable(signals.fd(), 1000ms));
+  EXPECT_EQ(signals.read(), SIGUSR2);
+  EXPECT_FALSE(signals.read());
+}
+
+TEST(Signals, WaitForSignalConsumesOneOrTimesOut) {
+  const sigset_t usr1 = signal_set({SIGUSR1});
+  block_signals(usr1);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(wait_for_signal(usr1, 50ms), 0);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 50ms);
+  ::raise(SIGUSR1);
+  EXPECT_EQ(wait_for_signal(usr1, 1000ms), SIGUSR1);
+  EXPECT_EQ(wait_for_signal(usr1, 0ms), 0);  // consumed
+}
+
+TEST(PeriodicTimer, FiresEveryPeriodAndNeverAtZero) {
+  PeriodicTimer timer(2ms);
+  ASSERT_TRUE(readable(timer.fd(), 1000ms));
+  EXPECT_GE(timer.consume(), 1u);
+  timer.arm(0us);
+  timer.consume();
+  EXPECT_FALSE(readable(timer.fd(), 30ms));
+  EXPECT_EQ(timer.consume(), 0u);
+  PeriodicTimer never(0us);
+  EXPECT_FALSE(readable(never.fd(), 30ms));
+}
+
+// A datagram socket standing for systemd's NOTIFY_SOCKET.
+class FakeNotifySocket {
+ public:
+  FakeNotifySocket() : path_(::testing::TempDir() + "/agnocast-service-watchdog.sock") {
+    ::unlink(path_.c_str());
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::strncpy(address.sun_path, path_.c_str(), sizeof(address.sun_path) - 1);
+    EXPECT_EQ(::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+    ::setenv("NOTIFY_SOCKET", path_.c_str(), 1);
+  }
+  ~FakeNotifySocket() {
+    ::unsetenv("NOTIFY_SOCKET");
+    ::close(fd_);
+    ::unlink(path_.c_str());
+  }
+  std::string received() {
+    char buffer[64] = {};
+    const ssize_t length = ::recv(fd_, buffer, sizeof(buffer), MSG_DONTWAIT);
+    return length > 0 ? std::string(buffer, static_cast<std::size_t>(length)) : "";
+  }
+
+ private:
+  std::string path_;
+  int fd_;
+};
+
+TEST(Watchdog, PingsOnlyWhenHealthy) {
+  FakeNotifySocket systemd;
+  ::unsetenv("WATCHDOG_PID");
+  ::setenv("WATCHDOG_USEC", "20000", 1);  // a ping every 10 ms
+  Watchdog watchdog;
+  ::unsetenv("WATCHDOG_USEC");
+  EXPECT_EQ(watchdog.interval(), 10ms);
+  ASSERT_TRUE(readable(watchdog.fd(), 1000ms));
+  EXPECT_FALSE(watchdog.tick(/*healthy=*/false));
+  EXPECT_EQ(systemd.received(), "");
+  ASSERT_TRUE(readable(watchdog.fd(), 1000ms));
+  EXPECT_TRUE(watchdog.tick(/*healthy=*/true));
+  EXPECT_EQ(systemd.received(), "WATCHDOG=1");
+}
+
+TEST(Watchdog, NeverFiresWhenSystemdDoesNotWatch) {
+  ::unsetenv("WATCHDOG_USEC");
+  Watchdog watchdog;
+  EXPECT_FALSE(watchdog.interval());
+  EXPECT_FALSE(readable(watchdog.fd(), 30ms));
+}
+
+}  // namespace
+}  // namespace agnocast_service

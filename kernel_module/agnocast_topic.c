@@ -406,10 +406,10 @@ void agnocast_endpoint_destroy(struct agnocast_endpoint *ep)
 }
 
 /* The caller's publisher or subscriber @id of the topic @handle. */
-int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool publisher,
-			     struct agnocast_endpoint **out)
+int agnocast_endpoint_lookup(struct agnocast_ns *ns, struct agnocast_proc *proc, u32 handle,
+			     u32 id, bool publisher, struct agnocast_endpoint **out)
 {
-	struct agnocast_topic *topic = agnocast_topic_by_handle(ctx->ns, handle);
+	struct agnocast_topic *topic = agnocast_topic_by_handle(ns, handle);
 	struct agnocast_endpoint *ep;
 
 	if (!topic)
@@ -417,7 +417,7 @@ int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool 
 	ep = xa_load(&topic->endpoints, id);
 	if (!ep || ep->publisher != publisher)
 		return -ENOENT;
-	if (ep->proc != ctx->proc)
+	if (ep->proc != proc)
 		return -EPERM;
 	*out = ep;
 	return 0;

@@ -164,7 +164,9 @@ u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic
 			continue;
 		sub = agnocast_to_subscriber(ep);
 		agnocast_sub_push(sub, entry);
-		if (agnocast_sub_wakes(sub) && !WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
+		if (!agnocast_sub_wakes(sub))
+			continue;
+		if (!WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
 			wake[nr_wake++] = ep->id;
 	}
 	if (pub->window_len > pub->ep.depth)

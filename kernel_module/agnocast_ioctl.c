@@ -197,7 +197,8 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		return ret;
-	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.publisher_id, true, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.publisher_id,
+				       true, &ep);
 	if (ret)
 		goto out_leave;
 	pub = agnocast_to_publisher(ep);
@@ -338,7 +339,8 @@ relock:
 	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		goto out_close;
-	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id,
+				       false, &ep);
 	if (ret)
 		goto out_leave;
 	sub = agnocast_to_subscriber(ep);
@@ -429,7 +431,8 @@ relock:
 	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		goto out_close;
-	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id,
+				       false, &ep);
 	if (ret)
 		goto out_leave;
 	sub = agnocast_to_subscriber(ep);
@@ -505,7 +508,8 @@ int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		goto out_free;
-	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id,
+				       false, &ep);
 	if (!ret) {
 		mutex_lock(&ep->topic->lock);
 		ret = agnocast_sub_release(agnocast_to_subscriber(ep), ids, arg.count);

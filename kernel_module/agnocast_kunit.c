@@ -176,7 +176,8 @@ static void agnocast_kunit_wake_set(struct kunit *test)
 	struct agnocast_publisher *pub = agnocast_kunit_pub(w, 4, 0);
 	struct agnocast_subscriber *cb = agnocast_kunit_sub(w, &w->other, 4, 0);
 	struct agnocast_subscriber *poll = agnocast_kunit_sub(w, &w->other, 4, AGNOCAST_POLLING);
-	struct agnocast_subscriber *own = agnocast_kunit_sub(w, &w->owner, 4, AGNOCAST_IGNORE_LOCAL);
+	struct agnocast_subscriber *own =
+		agnocast_kunit_sub(w, &w->owner, 4, AGNOCAST_IGNORE_LOCAL);
 	struct agnocast_subscriber *local = agnocast_kunit_sub(w, &w->owner, 4, 0);
 	struct agnocast_topic_entry *entry;
 	u32 wake[8], n;

@@ -123,11 +123,28 @@ static void agnocast_sub_push(struct agnocast_subscriber *sub,
 
 /*
  * Whether @sub is woken for a new entry: a callback subscriber is, through
- * its notification queue; a polling one never is.
+ * its notification queue, but one with AGNOCAST_WAKE_ONCE only if it was not
+ * woken since it last looked (RECEIVE or TAKE); a polling one never is.
  */
-static bool agnocast_sub_wakes(const struct agnocast_subscriber *sub)
+static bool agnocast_sub_wake(struct agnocast_subscriber *sub)
 {
-	return !(sub->ep.flags & AGNOCAST_POLLING);
+	if (sub->ep.flags & AGNOCAST_POLLING)
+		return false;
+	if (!(sub->ep.flags & AGNOCAST_WAKE_ONCE))
+		return true;
+	if (sub->notified)
+		return false;
+	sub->notified = true;
+	return true;
+}
+
+/*
+ * @sub looks at what is unreceived (RECEIVE or TAKE, whatever they return):
+ * the next entry published wakes it again.
+ */
+static void agnocast_sub_looks(struct agnocast_subscriber *sub)
+{
+	sub->notified = false;
 }
 
 /*
@@ -164,7 +181,7 @@ u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic
 			continue;
 		sub = agnocast_to_subscriber(ep);
 		agnocast_sub_push(sub, entry);
-		if (!agnocast_sub_wakes(sub))
+		if (!agnocast_sub_wake(sub))
 			continue;
 		if (!WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
 			wake[nr_wake++] = ep->id;
@@ -273,13 +290,14 @@ static void agnocast_entry_out(struct agnocast_entry *out,
  * releases @release_count held ones may take, within
  * max_held_per_subscriber (held entries about to be released count as
  * released already): -ENOENT when fewer are held than are to be released,
- * -EDQUOT when the quota is full and an entry waits.
+ * -EDQUOT when the quota is full and an entry waits.  The subscriber looks,
+ * whatever the answer.
  */
-int agnocast_sub_receivable(const struct agnocast_subscriber *sub, u32 release_count, u32 max,
-			    u32 *n)
+int agnocast_sub_receivable(struct agnocast_subscriber *sub, u32 release_count, u32 max, u32 *n)
 {
 	u32 held_after;
 
+	agnocast_sub_looks(sub);
 	if (release_count > sub->nr_held)
 		return -ENOENT;
 	held_after = sub->nr_held - release_count;
@@ -290,9 +308,13 @@ int agnocast_sub_receivable(const struct agnocast_subscriber *sub, u32 release_c
 	return 0;
 }
 
-/* Whether TAKE may hold one more entry of @sub: -EDQUOT when its quota is full. */
-int agnocast_sub_takeable(const struct agnocast_subscriber *sub)
+/*
+ * Whether TAKE may hold one more entry of @sub: -EDQUOT when its quota is
+ * full.  The subscriber looks, whatever the answer.
+ */
+int agnocast_sub_takeable(struct agnocast_subscriber *sub)
 {
+	agnocast_sub_looks(sub);
 	return sub->nr_held >= agnocast_max_held_per_subscriber ? -EDQUOT : 0;
 }
 

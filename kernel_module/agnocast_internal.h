@@ -215,6 +215,8 @@ struct agnocast_subscriber {
 	u32 held_capacity;
 	u64 received;
 	u64 dropped;
+	/* AGNOCAST_WAKE_ONCE: woken by a PUBLISH since its last RECEIVE or TAKE. */
+	bool notified;
 	/* Callback subscribers: queued when the process dies (ns->lock). */
 	struct agnocast_exit_record_node *exit_record;
 };
@@ -346,9 +348,8 @@ struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subsc
 						     u32 i);
 void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
-int agnocast_sub_receivable(const struct agnocast_subscriber *sub, u32 release_count, u32 max,
-			    u32 *n);
-int agnocast_sub_takeable(const struct agnocast_subscriber *sub);
+int agnocast_sub_receivable(struct agnocast_subscriber *sub, u32 release_count, u32 max, u32 *n);
+int agnocast_sub_takeable(struct agnocast_subscriber *sub);
 int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n);
 void agnocast_sub_receive(struct agnocast_subscriber *sub, struct agnocast_entry *out, u32 n);
 void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct agnocast_entry *out);

@@ -417,6 +417,57 @@ static void agnocast_kunit_transient(struct kunit *test)
 	agnocast_kunit_end(w);
 }
 
+/*
+ * A wake-once subscriber is woken by the first publish after it last looked
+ * and left out of the wake set until it looks again; others are woken by
+ * every publish.  Looking with nothing unreceived counts too.
+ */
+static void agnocast_kunit_wake_once(struct kunit *test)
+{
+	struct agnocast_kunit_world *w = agnocast_kunit_world(test);
+	struct agnocast_publisher *pub = agnocast_kunit_pub(w, 8, 0);
+	struct agnocast_subscriber *once = agnocast_kunit_sub(w, &w->other, 8, AGNOCAST_WAKE_ONCE);
+	struct agnocast_subscriber *every = agnocast_kunit_sub(w, &w->other, 8, 0);
+	struct agnocast_entry out[8];
+	u32 wake[8], i, n, sent = 0;
+
+	for (i = 0; i < 4; i++) {
+		agnocast_kunit_publish(w, pub, i * 64, wake, &n);
+		sent += n;
+		KUNIT_EXPECT_EQ(test, wake[n - 1], every->ep.id);
+		if (!i) {
+			KUNIT_EXPECT_EQ(test, n, 2U);
+			KUNIT_EXPECT_EQ(test, wake[0], once->ep.id);
+		} else {
+			KUNIT_EXPECT_EQ(test, n, 1U);
+		}
+	}
+	/* Four entries, five notifications: one for once, four for every. */
+	KUNIT_EXPECT_EQ(test, sent, 5U);
+	KUNIT_EXPECT_EQ(test, once->nr_unreceived, 4U);
+
+	/* A RECEIVE takes all four; the next publish wakes it again. */
+	mutex_lock(&w->topic.lock);
+	KUNIT_ASSERT_EQ(test, agnocast_sub_receivable(once, 0, 8, &n), 0);
+	KUNIT_ASSERT_EQ(test, n, 4U);
+	KUNIT_ASSERT_EQ(test, agnocast_sub_reserve_held(once, n), 0);
+	agnocast_sub_receive(once, out, n);
+	mutex_unlock(&w->topic.lock);
+	agnocast_kunit_publish(w, pub, 4 * 64, wake, &n);
+	KUNIT_ASSERT_EQ(test, n, 2U);
+	KUNIT_EXPECT_EQ(test, wake[0], once->ep.id);
+
+	/* A RECEIVE that finds the quota full still looks. */
+	agnocast_max_held_per_subscriber = 4;
+	mutex_lock(&w->topic.lock);
+	KUNIT_EXPECT_EQ(test, agnocast_sub_receivable(once, 0, 8, &n), -EDQUOT);
+	mutex_unlock(&w->topic.lock);
+	agnocast_kunit_publish(w, pub, 5 * 64, wake, &n);
+	KUNIT_ASSERT_EQ(test, n, 2U);
+	KUNIT_EXPECT_EQ(test, wake[0], once->ep.id);
+	agnocast_kunit_end(w);
+}
+
 static int agnocast_kunit_suite_init(struct kunit_suite *suite)
 {
 	return agnocast_entry_init();
@@ -436,6 +487,7 @@ static struct kunit_case agnocast_entry_cases[] = {
 	KUNIT_CASE(agnocast_kunit_shed),
 	KUNIT_CASE(agnocast_kunit_ownerless_pool),
 	KUNIT_CASE(agnocast_kunit_transient),
+	KUNIT_CASE(agnocast_kunit_wake_once),
 	{}
 };
 

@@ -228,14 +228,18 @@ bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg, bool 
 		return false;
 	if (!arg->depth || arg->depth > AGNOCAST_DEPTH_MAX)
 		return false;
-	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL))
+	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL |
+			   AGNOCAST_WAKE_ONCE))
+		return false;
+	if ((arg->flags & AGNOCAST_WAKE_ONCE) && (arg->flags & AGNOCAST_POLLING))
 		return false;
 	if (!agnocast_str_terminated(arg->type_name, sizeof(arg->type_name)) ||
 	    !agnocast_type_name_valid(arg->type_name))
 		return false;
 	if (arg->schema_size > AGNOCAST_SCHEMA_MAX || arg->reserved)
 		return false;
-	return !(publisher && (arg->flags & (AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL)));
+	return !(publisher &&
+		 (arg->flags & (AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL | AGNOCAST_WAKE_ONCE)));
 }
 
 /*

@@ -24,7 +24,6 @@
  * between, the call still reports success (it happened) and what it could
  * not write is lost, except reclaimable addresses, which stay pending.
  */
-#include <linux/pagemap.h>
 #include <linux/sched.h>
 #include <linux/uaccess.h>
 
@@ -105,37 +104,6 @@ void agnocast_leave(struct agnocast_ctx *ctx)
 	}
 	if (!ctx->ns_from_file)
 		agnocast_ns_put(ns);
-}
-
-/* Checks @bytes at @ubuf writable, keeping what the caller has there. */
-int agnocast_out_writable(u64 ubuf, size_t bytes)
-{
-	char __user *p = u64_to_user_ptr(ubuf);
-	char __user *end = p + bytes;
-	char c;
-
-	if (!bytes)
-		return 0;
-	if (!access_ok(p, bytes))
-		return -EFAULT;
-	/*
-	 * One byte of each page, written back with its own value: the page is
-	 * writable and present, and what the caller keeps there is unchanged.
-	 * Cheaper than fault_in_safe_writeable(), which walks the page tables
-	 * through get_user_pages for every call.
-	 */
-	while (p < end) {
-		if (get_user(c, p) || put_user(c, p))
-			return -EFAULT;
-		p = (char __user *)PAGE_ALIGN((unsigned long)p + 1);
-	}
-	return 0;
-}
-
-/* Writes an answer after commit; a failure loses only the answer (see above). */
-bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
-{
-	return !copy_to_user(to, from, bytes);
 }
 
 /*

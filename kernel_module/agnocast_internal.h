@@ -30,6 +30,9 @@
 #define _AGNOCAST_INTERNAL_H
 
 #include <linux/hashtable.h>
+#include <linux/kernel.h>
+#include <linux/mm.h>
+#include <linux/uaccess.h>
 #include <linux/idr.h>
 #include <linux/list.h>
 #include <linux/mutex.h>
@@ -400,9 +403,41 @@ int agnocast_enter_write(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
 int agnocast_enter_ns_read(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
 int agnocast_enter_ns_write(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
 void agnocast_leave(struct agnocast_ctx *ctx);
-int agnocast_out_writable(u64 ubuf, size_t bytes);
-bool agnocast_answer_out(void __user *to, const void *from, size_t bytes);
 int agnocast_unwritable(struct agnocast_ns *file_ns);
+
+/*
+ * Checks @bytes at @ubuf writable, keeping what the caller has there (on
+ * every PUBLISH and RECEIVE: inline).
+ */
+static inline int agnocast_out_writable(u64 ubuf, size_t bytes)
+{
+	char __user *p = u64_to_user_ptr(ubuf);
+	char __user *end = p + bytes;
+	char c;
+
+	if (!bytes)
+		return 0;
+	if (!access_ok(p, bytes))
+		return -EFAULT;
+	/*
+	 * One byte of each page, written back with its own value: the page is
+	 * writable and present, and what the caller keeps there is unchanged.
+	 * Cheaper than fault_in_safe_writeable(), which walks the page tables
+	 * through get_user_pages for every call.
+	 */
+	while (p < end) {
+		if (get_user(c, p) || put_user(c, p))
+			return -EFAULT;
+		p = (char __user *)PAGE_ALIGN((unsigned long)p + 1);
+	}
+	return 0;
+}
+
+/* Writes an answer after commit; a failure loses only the answer. */
+static inline bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
+{
+	return !copy_to_user(to, from, bytes);
+}
 
 /* agnocast_grant.c: pools handed to a subscriber (RECEIVE, TAKE). */
 struct agnocast_grants {

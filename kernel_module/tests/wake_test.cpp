@@ -7,15 +7,15 @@
 #include <gtest/gtest.h>
 #include <mqueue.h>
 #include <poll.h>
-#include <signal.h>
 #include <sched.h>
+#include <signal.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
-#include <new>
 #include <cstdio>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -27,13 +27,11 @@ namespace {
 
 class Wake : public ::testing::Test {
  protected:
-  void SetUp() override
-  {
+  void SetUp() override {
     dev = open_device();
     ASSERT_GE(dev, 0);
   }
-  void TearDown() override
-  {
+  void TearDown() override {
     reg.drop();
     close(dev);
   }
@@ -42,15 +40,14 @@ class Wake : public ::testing::Test {
 };
 
 // Receives everything unreceived of @sub, releasing it; returns the count.
-int receive_all(int dev, Endpoint sub, uint32_t *remaining_out = nullptr)
-{
+int receive_all(int dev, Endpoint sub, uint32_t* remaining_out = nullptr) {
   int total = 0;
   for (;;) {
     ReceiveResult rr;
     if (int ret = receive(dev, sub, &rr, 8); ret) return ret;
-    for (const agnocast_pool &pool : rr.pools) close(pool.fd);
+    for (const agnocast_pool& pool : rr.pools) close(pool.fd);
     std::vector<uint64_t> ids;
-    for (const agnocast_entry &entry : rr.entries) ids.push_back(entry.entry_id);
+    for (const agnocast_entry& entry : rr.entries) ids.push_back(entry.entry_id);
     if (!ids.empty() && release_list(dev, sub, ids)) return -1;
     total += static_cast<int>(rr.entries.size());
     if (remaining_out) *remaining_out = rr.remaining;
@@ -58,8 +55,7 @@ int receive_all(int dev, Endpoint sub, uint32_t *remaining_out = nullptr)
   }
 }
 
-TEST_F(Wake, FlagIsForCallbackSubscribersOnly)
-{
+TEST_F(Wake, FlagIsForCallbackSubscribersOnly) {
   ASSERT_EQ(reg.full(dev), 0);
   Endpoint ep;
   EXPECT_EQ(add_publisher(dev, "/wake/flags", 4, &ep, AGNOCAST_WAKE_ONCE), -EINVAL);
@@ -71,8 +67,7 @@ TEST_F(Wake, FlagIsForCallbackSubscribersOnly)
 // The publisher's notifications per message: 1 for a wake-once subscriber
 // between two of its RECEIVEs, one per message for a plain one, none for a
 // polling one.
-TEST_F(Wake, OneNotificationPerWakeup)
-{
+TEST_F(Wake, OneNotificationPerWakeup) {
   ASSERT_EQ(reg.full(dev), 0);
   Endpoint pub, once, plain, polling;
   ASSERT_EQ(add_publisher(dev, "/wake/count", 16, &pub), 0);
@@ -108,8 +103,7 @@ struct Shared {
   std::atomic<int> ready{0};
 };
 
-void pin_to_cpu(int cpu)
-{
+void pin_to_cpu(int cpu) {
   cpu_set_t set;
   CPU_ZERO(&set);
   CPU_SET(cpu % static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)), &set);
@@ -120,8 +114,7 @@ void pin_to_cpu(int cpu)
 // 2: a wait timed out while entries were unreceived, i.e. a lost wake-up).
 // Its queue is named like libagnocast's, topic@id (the race's topics have no
 // '/' but the first).
-int subscriber(Shared *shared, const std::string &topic, uint64_t messages, bool drain_after)
-{
+int subscriber(Shared* shared, const std::string& topic, uint64_t messages, bool drain_after) {
   pin_to_cpu(1);
   const int dev = open_device();
   Registration r;
@@ -160,7 +153,7 @@ int subscriber(Shared *shared, const std::string &topic, uint64_t messages, bool
   std::vector<agnocast_publisher_info> pubs;
   std::vector<agnocast_subscriber_info> subs;
   if (topic_info(dev, topic, &info, &pubs, &subs)) return 15;
-  for (const agnocast_subscriber_info &s : subs)
+  for (const agnocast_subscriber_info& s : subs)
     if (s.id == sub.id && s.dropped) return 16;
   mq_close(queue);
   mq_unlink(name.c_str());
@@ -170,10 +163,9 @@ int subscriber(Shared *shared, const std::string &topic, uint64_t messages, bool
 // One publisher and one wake-once subscriber on two CPUs: the publisher
 // publishes as fast as it can (but never more than the subscriber's depth
 // ahead, so nothing is dropped) and sends each notification PUBLISH asks for.
-void race(int dev, Registration &reg, const std::string &topic, uint64_t messages,
-          bool drain_after)
-{
-  auto *shared = static_cast<Shared *>(
+void race(int dev, Registration& reg, const std::string& topic, uint64_t messages,
+          bool drain_after) {
+  auto* shared = static_cast<Shared*>(
       mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0));
   ASSERT_NE(shared, MAP_FAILED);
   new (shared) Shared;
@@ -220,11 +212,12 @@ void race(int dev, Registration &reg, const std::string &topic, uint64_t message
   // when the subscriber looked, the next one's after): a wake-up is waiting
   // then, which is all it says.
   EXPECT_LE(sends, messages);
-  std::printf("%llu messages, %llu notifications sent (%.3f per message), %llu found the "
-              "queue full\n",
-              static_cast<unsigned long long>(messages), static_cast<unsigned long long>(sends),
-              static_cast<double>(sends) / static_cast<double>(messages),
-              static_cast<unsigned long long>(full));
+  std::printf(
+      "%llu messages, %llu notifications sent (%.3f per message), %llu found the "
+      "queue full\n",
+      static_cast<unsigned long long>(messages), static_cast<unsigned long long>(sends),
+      static_cast<double>(sends) / static_cast<double>(messages),
+      static_cast<unsigned long long>(full));
   munmap(shared, sizeof(Shared));
 }
 

@@ -27,7 +27,11 @@ static struct kmem_cache *agnocast_entry_cache;
 
 int agnocast_entry_init(void)
 {
-	agnocast_entry_cache = KMEM_CACHE(agnocast_topic_entry, SLAB_ACCOUNT);
+	/* Named after the module: the unit tests' copy of the engine has its own. */
+	agnocast_entry_cache = kmem_cache_create(KBUILD_MODNAME "_entry",
+						 sizeof(struct agnocast_topic_entry),
+						 __alignof__(struct agnocast_topic_entry),
+						 SLAB_ACCOUNT, NULL);
 	return agnocast_entry_cache ? 0 : -ENOMEM;
 }
 
@@ -117,12 +121,45 @@ static void agnocast_sub_push(struct agnocast_subscriber *sub,
 	entry->refs++;
 }
 
-/* Makes @entry (allocated, zeroed) the newest of @pub's topic. */
-void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
-			    struct agnocast_mempool *pool, u64 addr, u64 bytes)
+/*
+ * Whether @sub is woken for a new entry: a callback subscriber is, through
+ * its notification queue, but one with AGNOCAST_WAKE_ONCE only if it was not
+ * woken since it last looked (RECEIVE or TAKE); a polling one never is.
+ */
+static bool agnocast_sub_wake(struct agnocast_subscriber *sub)
+{
+	if (sub->ep.flags & AGNOCAST_POLLING)
+		return false;
+	if (!(sub->ep.flags & AGNOCAST_WAKE_ONCE))
+		return true;
+	if (sub->notified)
+		return false;
+	sub->notified = true;
+	return true;
+}
+
+/*
+ * @sub looks at what is unreceived (RECEIVE or TAKE, whatever they return):
+ * the next entry published wakes it again.
+ */
+static void agnocast_sub_looks(struct agnocast_subscriber *sub)
+{
+	sub->notified = false;
+}
+
+/*
+ * Makes @entry (allocated, zeroed) the newest of @pub's topic: every
+ * subscriber but those ignoring @pub's process gets it unreceived, and the
+ * ids of those to wake are written to @wake, which has room for the topic's
+ * callback subscribers.  Returns how many were written.
+ */
+u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
+			   struct agnocast_mempool *pool, u64 addr, u64 bytes, u32 *wake)
 {
 	struct agnocast_topic *topic = pub->ep.topic;
+	struct agnocast_subscriber *sub;
 	struct agnocast_endpoint *ep;
+	u32 nr_wake = 0;
 
 	lockdep_assert_held(&topic->lock);
 	entry->topic = topic;
@@ -139,13 +176,21 @@ void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topi
 	pub->window_len++;
 	pub->published++;
 	pub->published_bytes += bytes;
-	list_for_each_entry(ep, &topic->subscribers, topic_node)
-		if (!agnocast_sub_ignores(ep, pub))
-			agnocast_sub_push(agnocast_to_subscriber(ep), entry);
+	list_for_each_entry(ep, &topic->subscribers, topic_node) {
+		if (agnocast_sub_ignores(ep, pub))
+			continue;
+		sub = agnocast_to_subscriber(ep);
+		agnocast_sub_push(sub, entry);
+		if (!agnocast_sub_wake(sub))
+			continue;
+		if (!WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
+			wake[nr_wake++] = ep->id;
+	}
 	if (pub->window_len > pub->ep.depth)
 		agnocast_entry_leave_window(list_first_entry(&pub->window,
 							     struct agnocast_topic_entry,
 							     window_node));
+	return nr_wake;
 }
 
 /* @entry is transient-local history @sub gets. */
@@ -231,18 +276,74 @@ static void agnocast_sub_hold(struct agnocast_subscriber *sub,
 	sub->received++;
 }
 
-/* RECEIVE: the oldest unreceived entry becomes held (its room reserved). */
-void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub)
+static void agnocast_entry_out(struct agnocast_entry *out,
+			       const struct agnocast_topic_entry *entry)
 {
-	agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
+	memset(out, 0, sizeof(*out));
+	out->entry_id = entry->id;
+	out->addr = entry->addr;
+	out->publisher_id = entry->publisher_id;
 }
 
-/* TAKE: the newest becomes held; older unreceived entries are passed over. */
-void agnocast_sub_take_newest(struct agnocast_subscriber *sub)
+/*
+ * How many of @sub's unreceived entries a RECEIVE of at most @max that
+ * releases @release_count held ones may take, within
+ * max_held_per_subscriber (held entries about to be released count as
+ * released already): -ENOENT when fewer are held than are to be released,
+ * -EDQUOT when the quota is full and an entry waits.  The subscriber looks,
+ * whatever the answer.
+ */
+int agnocast_sub_receivable(struct agnocast_subscriber *sub, u32 release_count, u32 max, u32 *n)
 {
+	u32 held_after;
+
+	agnocast_sub_looks(sub);
+	if (release_count > sub->nr_held)
+		return -ENOENT;
+	held_after = sub->nr_held - release_count;
+	*n = min(max, sub->nr_unreceived);
+	if (held_after >= agnocast_max_held_per_subscriber)
+		return *n ? -EDQUOT : 0;
+	*n = min(*n, agnocast_max_held_per_subscriber - held_after);
+	return 0;
+}
+
+/*
+ * Whether TAKE may hold one more entry of @sub: -EDQUOT when its quota is
+ * full.  The subscriber looks, whatever the answer.
+ */
+int agnocast_sub_takeable(struct agnocast_subscriber *sub)
+{
+	agnocast_sub_looks(sub);
+	return sub->nr_held >= agnocast_max_held_per_subscriber ? -EDQUOT : 0;
+}
+
+/*
+ * RECEIVE: the @n oldest unreceived entries (room reserved) become held,
+ * described in @out, oldest first.
+ */
+void agnocast_sub_receive(struct agnocast_subscriber *sub, struct agnocast_entry *out, u32 n)
+{
+	u32 i;
+
+	lockdep_assert_held(&sub->ep.topic->lock);
+	for (i = 0; i < n; i++) {
+		agnocast_entry_out(&out[i], sub->unreceived[sub->head]);
+		agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
+	}
+}
+
+/*
+ * TAKE: the newest unreceived entry (room reserved) becomes held, described
+ * in @out; older unreceived entries are passed over, not dropped.
+ */
+void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct agnocast_entry *out)
+{
+	lockdep_assert_held(&sub->ep.topic->lock);
 	while (sub->nr_unreceived > 1)
 		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
-	agnocast_sub_hold_oldest(sub);
+	agnocast_entry_out(out, sub->unreceived[sub->head]);
+	agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
 }
 
 /* While a release is checked, bit 0 of a held pointer flags it listed. */
@@ -323,7 +424,7 @@ int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n)
  * Takes from @sub's unreceived entries those of @pool that have left their
  * publisher's window; keeps the order of the rest.
  */
-u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool)
+static u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool)
 {
 	u32 i, kept = 0, shed = 0, n = sub->nr_unreceived;
 
@@ -341,6 +442,30 @@ u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *
 	}
 	sub->nr_unreceived = kept;
 	sub->dropped += shed;
+	return shed;
+}
+
+/*
+ * SHED: takes from the subscribers of every topic @proc publishes the
+ * entries of its pool that wait only to be received (counted in their
+ * @dropped); held entries stay.  Takes each topic's lock in turn.  Returns
+ * how many were taken; @reclaimable is then the length of @proc's reclaim
+ * list.
+ */
+u32 agnocast_proc_shed(struct agnocast_proc *proc, u32 *reclaimable)
+{
+	struct agnocast_endpoint *pub, *sub;
+	u32 shed = 0;
+
+	list_for_each_entry(pub, &proc->publishers, proc_node) {
+		mutex_lock(&pub->topic->lock);
+		list_for_each_entry(sub, &pub->topic->subscribers, topic_node)
+			shed += agnocast_sub_shed(agnocast_to_subscriber(sub), proc->pool);
+		mutex_unlock(&pub->topic->lock);
+	}
+	spin_lock(&proc->reclaim_lock);
+	*reclaimable = proc->nr_reclaim;
+	spin_unlock(&proc->reclaim_lock);
 	return shed;
 }
 

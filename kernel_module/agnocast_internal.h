@@ -30,6 +30,9 @@
 #define _AGNOCAST_INTERNAL_H
 
 #include <linux/hashtable.h>
+#include <linux/kernel.h>
+#include <linux/mm.h>
+#include <linux/uaccess.h>
 #include <linux/idr.h>
 #include <linux/list.h>
 #include <linux/mutex.h>
@@ -215,6 +218,8 @@ struct agnocast_subscriber {
 	u32 held_capacity;
 	u64 received;
 	u64 dropped;
+	/* AGNOCAST_WAKE_ONCE: woken by a PUBLISH since its last RECEIVE or TAKE. */
+	bool notified;
 	/* Callback subscribers: queued when the process dies (ns->lock). */
 	struct agnocast_exit_record_node *exit_record;
 };
@@ -270,7 +275,7 @@ struct agnocast_file {
 	bool may_read_exit_records;	/* decided at open */
 };
 
-/* The calling process's view, valid between agnocast_enter/agnocast_leave. */
+/* The calling process's view, valid between agnocast_enter_*() and agnocast_leave(). */
 struct agnocast_ctx {
 	struct agnocast_ns *ns;
 	struct agnocast_proc *proc;	/* NULL if not registered */
@@ -293,20 +298,33 @@ bool agnocast_exit_records_waiting(const struct agnocast_ns *ns);
 ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
 				   size_t count, bool nonblock);
 
-/* agnocast_process.c */
-int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered,
-		   bool write);
-void agnocast_leave(struct agnocast_ctx *ctx);
+/* agnocast_process.c: registered processes, exit detection, teardown. */
 int agnocast_process_init(void);
 void agnocast_process_exit(void);
-int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg);
-int agnocast_unregister_process(struct agnocast_ns *file_ns);
+void agnocast_proc_settle_current(void);
+int agnocast_proc_find_current(struct agnocast_ns *ns, struct agnocast_proc **out);
+struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns);
+void agnocast_proc_unregister(struct agnocast_proc *proc);
 
-/* agnocast_policy.c */
+/* agnocast_policy.c: the namespace's topic access policy. */
+/* A policy in UAPI form, to copy out. */
+struct agnocast_policy_copy {
+	u32 flags;
+	u32 nr_rules;
+	u32 nr_principals;
+	struct agnocast_policy_rule *rules;
+	struct agnocast_principal *principals;
+};
+
+bool agnocast_policy_arg_valid(const struct agnocast_policy *arg);
+struct agnocast_policy_state *agnocast_policy_build(const struct agnocast_policy *arg,
+						    const struct agnocast_policy_rule *rules,
+						    const struct agnocast_principal *principals);
 int agnocast_policy_check(const struct agnocast_ns *ns, const char *topic, bool publisher);
 void agnocast_policy_free(struct agnocast_policy_state *policy);
-int agnocast_set_policy(struct agnocast_ns *file_ns, void __user *uarg);
-int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_policy_snapshot(const struct agnocast_policy_state *policy,
+			     struct agnocast_policy_copy *copy);
+void agnocast_policy_copy_free(struct agnocast_policy_copy *copy);
 
 /* agnocast_pool.c */
 struct agnocast_mempool *agnocast_pool_reserve(struct agnocast_ns *ns,
@@ -326,18 +344,20 @@ int agnocast_entry_init(void);
 void agnocast_entry_exit(void);
 struct agnocast_topic_entry *agnocast_entry_alloc(void);
 void agnocast_entry_free(struct agnocast_topic_entry *entry);
-void agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
-			    struct agnocast_mempool *pool, u64 addr, u64 bytes);
+u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
+			   struct agnocast_mempool *pool, u64 addr, u64 bytes, u32 *wake);
 void agnocast_publisher_drop_window(struct agnocast_publisher *pub);
 struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subscriber *sub,
 						     u32 i);
 void agnocast_sub_fill_transient(struct agnocast_subscriber *sub);
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub);
+int agnocast_sub_receivable(struct agnocast_subscriber *sub, u32 release_count, u32 max, u32 *n);
+int agnocast_sub_takeable(struct agnocast_subscriber *sub);
 int agnocast_sub_reserve_held(struct agnocast_subscriber *sub, u32 n);
-void agnocast_sub_hold_oldest(struct agnocast_subscriber *sub);
-void agnocast_sub_take_newest(struct agnocast_subscriber *sub);
+void agnocast_sub_receive(struct agnocast_subscriber *sub, struct agnocast_entry *out, u32 n);
+void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct agnocast_entry *out);
 int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n);
-u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_mempool *pool);
+u32 agnocast_proc_shed(struct agnocast_proc *proc, u32 *reclaimable);
 u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *pending);
 void agnocast_reclaim_return(struct agnocast_proc *proc, const u64 *addrs, u32 n);
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
@@ -357,8 +377,8 @@ struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
 void agnocast_endpoint_commit(struct agnocast_endpoint *ep);
 void agnocast_endpoint_abandon(struct agnocast_endpoint *ep);
 void agnocast_endpoint_destroy(struct agnocast_endpoint *ep);
-int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool publisher,
-			     struct agnocast_endpoint **out);
+int agnocast_endpoint_lookup(struct agnocast_ns *ns, struct agnocast_proc *proc, u32 handle,
+			     u32 id, bool publisher, struct agnocast_endpoint **out);
 void agnocast_proc_drop_endpoints(struct agnocast_proc *proc);
 void agnocast_id_spaces_free(struct agnocast_ns *ns);
 
@@ -372,7 +392,81 @@ static inline struct agnocast_subscriber *agnocast_to_subscriber(struct agnocast
 	return container_of(ep, struct agnocast_subscriber, ep);
 }
 
-/* agnocast_ioctl.c: endpoint and data-path commands (copy in, call down, copy out). */
+/*
+ * The handlers: copy in, enter, call down, leave, copy out.  Nothing below
+ * them calls back up.
+ */
+
+/* agnocast_call.c: the call context and the lock each call takes. */
+int agnocast_enter_read(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
+int agnocast_enter_write(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
+int agnocast_enter_ns_read(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
+int agnocast_enter_ns_write(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns);
+void agnocast_leave(struct agnocast_ctx *ctx);
+int agnocast_unwritable(struct agnocast_ns *file_ns);
+
+/*
+ * Checks @bytes at @ubuf writable, keeping what the caller has there (on
+ * every PUBLISH and RECEIVE: inline).
+ */
+static inline int agnocast_out_writable(u64 ubuf, size_t bytes)
+{
+	char __user *p = u64_to_user_ptr(ubuf);
+	char __user *end = p + bytes;
+	char c;
+
+	if (!bytes)
+		return 0;
+	if (!access_ok(p, bytes))
+		return -EFAULT;
+	/*
+	 * One byte of each page, written back with its own value: the page is
+	 * writable and present, and what the caller keeps there is unchanged.
+	 * Cheaper than fault_in_safe_writeable(), which walks the page tables
+	 * through get_user_pages for every call.
+	 */
+	while (p < end) {
+		if (get_user(c, p) || put_user(c, p))
+			return -EFAULT;
+		p = (char __user *)PAGE_ALIGN((unsigned long)p + 1);
+	}
+	return 0;
+}
+
+/* Writes an answer after commit; a failure loses only the answer. */
+static inline bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
+{
+	return !copy_to_user(to, from, bytes);
+}
+
+/* agnocast_grant.c: pools handed to a subscriber (RECEIVE, TAKE). */
+struct agnocast_grants {
+	struct file *files[AGNOCAST_RECEIVE_POOLS_MAX];
+	struct agnocast_pool out[AGNOCAST_RECEIVE_POOLS_MAX];
+	u32 count;
+	u32 capacity;
+	/* TAKE: a grant replaced by another, to close and put unlocked. */
+	struct file *stale_file;
+	int stale_fd;
+};
+
+bool agnocast_grants_readable(const struct agnocast_proc *proc,
+			      const struct agnocast_grants *grants,
+			      const struct agnocast_mempool *pool);
+bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_mempool *pool);
+void agnocast_grants_add_over(struct agnocast_grants *grants, struct agnocast_mempool *pool);
+int agnocast_grants_install(struct agnocast_grants *grants, u32 from);
+void agnocast_grants_commit(struct agnocast_proc *proc, const struct agnocast_grants *grants);
+void agnocast_grants_put(struct agnocast_grants *grants);
+void agnocast_grants_close(struct agnocast_grants *grants);
+
+/* agnocast_admin.c: processes and the access policy. */
+int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_unregister_process(struct agnocast_ns *file_ns);
+int agnocast_set_policy(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg);
+
+/* agnocast_ioctl.c: endpoint and data-path commands. */
 int agnocast_add_publisher(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg);

@@ -42,7 +42,7 @@ int agnocast_list_topics(struct agnocast_ns *file_ns, void __user *uarg)
 		return -EFAULT;
 	if (arg.flags || arg.reserved)
 		return -EINVAL;
-	ret = agnocast_enter(&ctx, file_ns, false, false);
+	ret = agnocast_enter_ns_read(&ctx, file_ns);
 	if (ret)
 		return ret;
 
@@ -184,7 +184,7 @@ int agnocast_topic_info(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EINVAL;
 	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
 		goto out_free;
-	ret = agnocast_enter(&ctx, file_ns, false, false);
+	ret = agnocast_enter_ns_read(&ctx, file_ns);
 	if (ret)
 		goto out_free;
 	ret = agnocast_topic_info_build(ctx.ns, arg, &answer);
@@ -226,7 +226,7 @@ int agnocast_list_processes(struct agnocast_ns *file_ns, void __user *uarg)
 		return -EFAULT;
 	if (arg.flags || arg.reserved)
 		return -EINVAL;
-	ret = agnocast_enter(&ctx, file_ns, false, false);
+	ret = agnocast_enter_ns_read(&ctx, file_ns);
 	if (ret)
 		return ret;
 
@@ -278,7 +278,7 @@ int agnocast_topic_schema(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EINVAL;
 	if (!memchr(arg->name, '\0', sizeof(arg->name)) || !agnocast_topic_name_valid(arg->name))
 		goto out_free_arg;
-	ret = agnocast_enter(&ctx, file_ns, false, false);
+	ret = agnocast_enter_ns_read(&ctx, file_ns);
 	if (ret)
 		goto out_free_arg;
 	topic = agnocast_topic_find(ctx.ns, arg->name);

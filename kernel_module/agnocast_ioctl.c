@@ -2,15 +2,13 @@
 /*
  * agnocast: the endpoint and data-path commands.
  *
- * Each handler copies its argument in, calls down into topics
- * (agnocast_topic.c) and the entry engine (agnocast_entry.c) under the
- * namespace lock, and copies the answer out.  Nothing below calls back here.
+ * Each handler copies its argument in, enters the call context
+ * (agnocast_call.c), calls down into topics (agnocast_topic.c), access
+ * grants (agnocast_grant.c) and the entry engine (agnocast_entry.c), which
+ * makes every per-message decision, leaves, and copies the answer out.
+ * Nothing below calls back here.
  */
-#include <linux/fdtable.h>
-#include <linux/file.h>
-#include <linux/version.h>
 #include <linux/minmax.h>
-#include <linux/pagemap.h>
 #include <linux/slab.h>
 #include <linux/string.h>
 #include <linux/uaccess.h>
@@ -51,7 +49,7 @@ static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 			goto out_free_arg;
 	}
 
-	ret = agnocast_enter(&ctx, file_ns, true, true);
+	ret = agnocast_enter_write(&ctx, file_ns);
 	if (ret)
 		goto out_free_arg;
 	ret = agnocast_policy_check(ctx.ns, arg->topic, publisher);
@@ -122,10 +120,10 @@ static int agnocast_remove_endpoint(struct agnocast_ns *file_ns, void __user *ua
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	ret = agnocast_enter(&ctx, file_ns, true, true);
+	ret = agnocast_enter_write(&ctx, file_ns);
 	if (ret)
 		return ret;
-	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.id, publisher, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.id, publisher, &ep);
 	if (!ret) {
 		topic = ep->topic;
 		agnocast_endpoint_destroy(ep);
@@ -146,59 +144,6 @@ int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg)
 }
 
 
-/*
- * Output buffers are checked writable before anything commits, so that a
- * call fails with -EFAULT only while it has done nothing.  They are written
- * after the namespace lock is dropped; should another thread unmap them in
- * between, the call still reports success (it happened) and what it could
- * not write is lost, except reclaimable addresses, which stay pending.
- */
-static int agnocast_out_writable(u64 ubuf, size_t bytes)
-{
-	char __user *p = u64_to_user_ptr(ubuf);
-	char __user *end = p + bytes;
-	char c;
-
-	if (!bytes)
-		return 0;
-	if (!access_ok(p, bytes))
-		return -EFAULT;
-	/*
-	 * One byte of each page, written back with its own value: the page is
-	 * writable and present, and what the caller keeps there is unchanged.
-	 * Cheaper than fault_in_safe_writeable(), which walks the page tables
-	 * through get_user_pages for every call.
-	 */
-	while (p < end) {
-		if (get_user(c, p) || put_user(c, p))
-			return -EFAULT;
-		p = (char __user *)PAGE_ALIGN((unsigned long)p + 1);
-	}
-	return 0;
-}
-
-/* Writes an answer after commit; a failure loses only the answer (see above). */
-static bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
-{
-	return !copy_to_user(to, from, bytes);
-}
-
-/*
- * An unwritable output is -EFAULT, but an unregistered caller learns that
- * first, as it would if the buffers were fine.
- */
-static int agnocast_unwritable(struct agnocast_ns *file_ns)
-{
-	struct agnocast_ctx ctx;
-	int ret;
-
-	ret = agnocast_enter(&ctx, file_ns, true, false);
-	if (ret)
-		return ret;
-	agnocast_leave(&ctx);
-	return -EFAULT;
-}
-
 /* Probes a field of the argument for writing, keeping its value. */
 #define agnocast_arg_writable(ufield, value) (put_user(value, ufield) ? -EFAULT : 0)
 
@@ -214,7 +159,7 @@ static void agnocast_reclaim_copy_out(struct agnocast_ns *file_ns, u64 ubuf, con
 
 	if (!n || agnocast_answer_out(u64_to_user_ptr(ubuf), addrs, n * sizeof(*addrs)))
 		return;
-	if (agnocast_enter(&ctx, file_ns, true, false))
+	if (agnocast_enter_read(&ctx, file_ns))
 		return;
 	pool = ctx.proc->pool;
 	if (addrs[0] >= pool->addr && addrs[0] - pool->addr < pool->size)
@@ -249,10 +194,11 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	    agnocast_arg_writable(&upublish->reserved, 0))
 		return agnocast_unwritable(file_ns);
 
-	ret = agnocast_enter(&ctx, file_ns, true, false);
+	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		return ret;
-	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.publisher_id, true, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.publisher_id,
+				       true, &ep);
 	if (ret)
 		goto out_leave;
 	pub = agnocast_to_publisher(ep);
@@ -279,12 +225,8 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 		goto out_leave;
 
 	/* Committed: nothing below fails. */
-	list_for_each_entry(ep, &topic->subscribers, topic_node) {
-		if (!(ep->flags & AGNOCAST_POLLING) && !agnocast_sub_ignores(ep, pub))
-			wake[wake_count++] = ep->id;
-	}
 	mutex_lock(&topic->lock);
-	agnocast_entry_publish(pub, entry, pool, arg.addr, arg.bytes);
+	wake_count = agnocast_entry_publish(pub, entry, pool, arg.addr, arg.bytes, wake);
 	arg.entry_id = entry->id;
 	mutex_unlock(&topic->lock);
 	arg.wake_count = wake_count;
@@ -321,7 +263,7 @@ int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
 	if (agnocast_out_writable(arg.reclaim, reclaim_max * sizeof(u64)) ||
 	    agnocast_arg_writable(&ureclaim->reserved, 0))
 		return agnocast_unwritable(file_ns);
-	ret = agnocast_enter(&ctx, file_ns, true, false);
+	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		return ret;
 	arg.reclaim_count = agnocast_reclaim_take(ctx.proc, reclaim, reclaim_max,
@@ -355,145 +297,6 @@ static int agnocast_release_ids_in(u64 uids, u32 count, u64 *small, u64 **ids)
 	return 0;
 }
 
-static void agnocast_entry_out(struct agnocast_entry *out,
-			       const struct agnocast_topic_entry *entry)
-{
-	memset(out, 0, sizeof(*out));
-	out->entry_id = entry->id;
-	out->addr = entry->addr;
-	out->publisher_id = entry->publisher_id;
-}
-
-/*
- * Pools handed to a subscriber.  Descriptors are installed with receive_fd()
- * (the kernel's path for passing files, with its security check) while no
- * lock is held, before the entries that need them are committed: a call that
- * needs a pool the caller lacks takes a reference on its file, drops the
- * namespace lock, installs, and locks again.  Entries are then received only
- * up to the first one whose pool is neither the caller's nor given to it.
- */
-struct agnocast_grants {
-	struct file *files[AGNOCAST_RECEIVE_POOLS_MAX];
-	struct agnocast_pool out[AGNOCAST_RECEIVE_POOLS_MAX];
-	u32 count;
-	u32 capacity;
-	/* TAKE: a grant replaced by another, to close and put unlocked. */
-	struct file *stale_file;
-	int stale_fd;
-};
-
-static bool agnocast_grants_has(const struct agnocast_grants *grants,
-				const struct agnocast_mempool *pool)
-{
-	u32 i;
-
-	for (i = 0; i < grants->count; i++) {
-		if (grants->files[i] == pool->file)
-			return true;
-	}
-	return false;
-}
-
-/* Whether @proc can read @pool once the grants are committed. */
-static bool agnocast_pool_readable(const struct agnocast_proc *proc,
-				   const struct agnocast_grants *grants,
-				   const struct agnocast_mempool *pool)
-{
-	return !agnocast_pool_needs_giving(proc, pool) || agnocast_grants_has(grants, pool);
-}
-
-/* Adds @pool to the grants to install; false when they are full. */
-static bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_mempool *pool)
-{
-	if (grants->count == grants->capacity)
-		return false;
-	agnocast_pool_describe(pool, &grants->out[grants->count]);
-	grants->files[grants->count++] = get_file(pool->file);
-	return true;
-}
-
-/*
- * TAKE's one grant: the installed descriptor of a pool the newest entry no
- * longer needs is closed once no lock is held (agnocast_grants_install()).
- */
-static void agnocast_grants_add_over(struct agnocast_grants *grants,
-				     struct agnocast_mempool *pool)
-{
-	if (grants->count) {
-		grants->stale_fd = grants->out[0].fd;
-		grants->stale_file = grants->files[0];
-		grants->count = 0;
-	}
-	agnocast_grants_add(grants, pool);
-}
-
-static int agnocast_receive_fd(struct file *file)
-{
-#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 8, 0)
-	return receive_fd(file, NULL, O_CLOEXEC);
-#else
-	return receive_fd(file, O_CLOEXEC);
-#endif
-}
-
-/*
- * Installs grants @from.. (no lock held); on failure closes and forgets
- * what this call to it added.
- */
-static int agnocast_grants_install(struct agnocast_grants *grants, u32 from)
-{
-	u32 i;
-	int fd;
-
-	if (grants->stale_file) {
-		close_fd(grants->stale_fd);
-		fput(grants->stale_file);
-		grants->stale_file = NULL;
-	}
-	for (i = from; i < grants->count; i++) {
-		fd = agnocast_receive_fd(grants->files[i]);
-		if (fd < 0)
-			goto err_undo;
-		grants->out[i].fd = fd;
-	}
-	return 0;
-
-err_undo:
-	while (i-- > from)
-		close_fd(grants->out[i].fd);
-	for (i = from; i < grants->count; i++)
-		fput(grants->files[i]);
-	grants->count = from;
-	return fd;
-}
-
-/* Marks the granted pools given (those still alive); namespace lock held. */
-static void agnocast_grants_commit(struct agnocast_proc *proc,
-				   const struct agnocast_grants *grants)
-{
-	u32 i;
-
-	for (i = 0; i < grants->count; i++)
-		agnocast_pool_mark_given(proc, &grants->out[i], grants->files[i]);
-}
-
-static void agnocast_grants_put(struct agnocast_grants *grants)
-{
-	u32 i;
-
-	for (i = 0; i < grants->count; i++)
-		fput(grants->files[i]);
-}
-
-/* Closes installed descriptors of a call that failed after installing them. */
-static void agnocast_grants_close(struct agnocast_grants *grants)
-{
-	u32 i;
-
-	for (i = 0; i < grants->count; i++)
-		close_fd(grants->out[i].fd);
-}
-
 int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	/* A wake-up usually finds one entry: small receives need no allocation. */
@@ -508,7 +311,7 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 	struct agnocast_endpoint *ep;
 	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
-	u32 n, i, entry_max, held_after, installed = 0;
+	u32 n, i, entry_max, installed = 0;
 	int ret;
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
@@ -533,33 +336,24 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 	}
 
 relock:
-	ret = agnocast_enter(&ctx, file_ns, true, false);
+	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		goto out_close;
-	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id,
+				       false, &ep);
 	if (ret)
 		goto out_leave;
 	sub = agnocast_to_subscriber(ep);
 	topic = ep->topic;
 	mutex_lock(&topic->lock);
-	/* Held entries about to be released count as released already. */
-	ret = -ENOENT;
-	if (arg.release_count > sub->nr_held)
+	ret = agnocast_sub_receivable(sub, arg.release_count, entry_max, &n);
+	if (ret)
 		goto out_unlock;
-	held_after = sub->nr_held - arg.release_count;
-	n = min(entry_max, sub->nr_unreceived);
-	ret = -EDQUOT;
-	if (held_after >= agnocast_max_held_per_subscriber) {
-		if (n)
-			goto out_unlock;
-	} else {
-		n = min(n, agnocast_max_held_per_subscriber - held_after);
-	}
 	/* Oldest first; stop at an entry whose pool does not fit in the grants. */
 	for (i = 0; i < n; i++) {
 		struct agnocast_mempool *pool = agnocast_sub_unreceived(sub, i)->pool;
 
-		if (!agnocast_pool_readable(ctx.proc, &grants, pool) &&
+		if (!agnocast_grants_readable(ctx.proc, &grants, pool) &&
 		    !agnocast_grants_add(&grants, pool))
 			break;
 	}
@@ -581,11 +375,8 @@ relock:
 		goto out_unlock;
 
 	/* Commit: nothing below fails. */
-	for (i = 0; i < n; i++)
-		agnocast_entry_out(&entries[i], agnocast_sub_unreceived(sub, i));
 	agnocast_grants_commit(ctx.proc, &grants);
-	for (i = 0; i < n; i++)
-		agnocast_sub_hold_oldest(sub);
+	agnocast_sub_receive(sub, entries, n);
 	arg.entry_count = n;
 	arg.pool_count = grants.count;
 	arg.remaining = sub->nr_unreceived;
@@ -637,10 +428,11 @@ int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 		return agnocast_unwritable(file_ns);
 
 relock:
-	ret = agnocast_enter(&ctx, file_ns, true, false);
+	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		goto out_close;
-	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id,
+				       false, &ep);
 	if (ret)
 		goto out_leave;
 	sub = agnocast_to_subscriber(ep);
@@ -651,11 +443,11 @@ relock:
 	arg.pool_count = 0;
 	mutex_lock(&topic->lock);
 	if (sub->nr_unreceived) {
-		ret = -EDQUOT;
-		if (sub->nr_held >= agnocast_max_held_per_subscriber)
+		ret = agnocast_sub_takeable(sub);
+		if (ret)
 			goto out_unlock;
 		entry = agnocast_sub_unreceived(sub, sub->nr_unreceived - 1);
-		if (!agnocast_pool_readable(ctx.proc, &grants, entry->pool)) {
+		if (!agnocast_grants_readable(ctx.proc, &grants, entry->pool)) {
 			/* Install its pool, then look again: the newest may have moved. */
 			ret = -EAGAIN;
 			if (++attempts > AGNOCAST_TAKE_ATTEMPTS)
@@ -671,10 +463,9 @@ relock:
 		ret = agnocast_sub_reserve_held(sub, 1);
 		if (ret)
 			goto out_unlock;
-		/* Commit: older unreceived entries are passed over, not dropped. */
-		agnocast_entry_out(&arg.entry, entry);
+		/* Commit: nothing below fails. */
+		agnocast_sub_take_newest(sub, &arg.entry);
 		arg.entry_count = 1;
-		agnocast_sub_take_newest(sub);
 	}
 	if (grants.count) {
 		agnocast_grants_commit(ctx.proc, &grants);
@@ -714,10 +505,11 @@ int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = agnocast_release_ids_in(arg.entry_ids, arg.count, ids_small, &ids);
 	if (ret)
 		return ret;
-	ret = agnocast_enter(&ctx, file_ns, true, false);
+	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		goto out_free;
-	ret = agnocast_endpoint_lookup(&ctx, arg.topic_handle, arg.subscriber_id, false, &ep);
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.subscriber_id,
+				       false, &ep);
 	if (!ret) {
 		mutex_lock(&ep->topic->lock);
 		ret = agnocast_sub_release(agnocast_to_subscriber(ep), ids, arg.count);
@@ -732,24 +524,14 @@ out_free:
 
 int agnocast_shed(struct agnocast_ns *file_ns, void __user *uarg)
 {
-	struct agnocast_endpoint *pub, *sub;
 	struct agnocast_shed arg = {};
 	struct agnocast_ctx ctx;
 	int ret;
 
-	ret = agnocast_enter(&ctx, file_ns, true, false);
+	ret = agnocast_enter_read(&ctx, file_ns);
 	if (ret)
 		return ret;
-	list_for_each_entry(pub, &ctx.proc->publishers, proc_node) {
-		mutex_lock(&pub->topic->lock);
-		list_for_each_entry(sub, &pub->topic->subscribers, topic_node)
-			arg.shed += agnocast_sub_shed(agnocast_to_subscriber(sub),
-						      ctx.proc->pool);
-		mutex_unlock(&pub->topic->lock);
-	}
-	spin_lock(&ctx.proc->reclaim_lock);
-	arg.reclaimable = ctx.proc->nr_reclaim;
-	spin_unlock(&ctx.proc->reclaim_lock);
+	arg.shed = agnocast_proc_shed(ctx.proc, &arg.reclaimable);
 	agnocast_leave(&ctx);
 	if (copy_to_user(uarg, &arg, sizeof(arg)))
 		return -EFAULT;

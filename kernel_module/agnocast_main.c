@@ -2,8 +2,9 @@
 /*
  * agnocast: module parameters, the /dev/agnocast device and ioctl dispatch.
  *
- * The ioctl handler is a thin switch; each command lives in the file that
- * owns its state and copies its own argument in and out.  Every open file
+ * The ioctl handler is a thin switch into the handlers (agnocast_admin.c,
+ * agnocast_ioctl.c, agnocast_introspect.c), each of which copies its own
+ * argument in and out.  Every open file
  * holds a user reference on the opener's namespace state, which read() and
  * poll() use for exit records, and whether its opener may read them.
  */
@@ -216,6 +217,7 @@ static struct miscdevice agnocast_misc = {
 	.mode = 0660,
 };
 
+/* Each step is undone by agnocast_exit() in reverse order, and here on failure. */
 static int __init agnocast_init(void)
 {
 	int ret;
@@ -226,20 +228,21 @@ static int __init agnocast_init(void)
 	ret = agnocast_entry_init();
 	if (ret)
 		return ret;
+	agnocast_ns_init();
 	ret = agnocast_process_init();
 	if (ret)
-		goto err_entry_exit;
-	agnocast_ns_init();
+		goto err_ns_exit;
 	ret = misc_register(&agnocast_misc);
 	if (ret) {
 		pr_err("agnocast: cannot register /dev/agnocast: %d\n", ret);
-		agnocast_ns_exit();
-		agnocast_process_exit();
-		goto err_entry_exit;
+		goto err_process_exit;
 	}
 	return 0;
 
-err_entry_exit:
+err_process_exit:
+	agnocast_process_exit();
+err_ns_exit:
+	agnocast_ns_exit();
 	agnocast_entry_exit();
 	return ret;
 }
@@ -247,6 +250,7 @@ err_entry_exit:
 static void __exit agnocast_exit(void)
 {
 	misc_deregister(&agnocast_misc);
+	/* Teardowns still queued end here, before the states they use go. */
 	agnocast_process_exit();
 	agnocast_ns_exit();
 	agnocast_entry_exit();

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: GPL-2.0
 /*
- * agnocast: the topic access policy of an IPC namespace (SET_POLICY,
- * GET_POLICY), checked when an endpoint is created.
+ * agnocast: the topic access policy of an IPC namespace: built from its UAPI
+ * form, checked when an endpoint is created, snapshotted back to UAPI form.
  *
- * A new policy is copied in and validated before any lock is taken, then
- * swapped in under the namespace lock; GET_POLICY copies it out only after
- * dropping that lock.  Ids are stored as kernel ids, translated from and to
- * the caller's user namespace.  Existing endpoints are never re-checked.
+ * The SET_POLICY and GET_POLICY handlers (agnocast_admin.c) copy a policy in
+ * and have it built and validated before any lock is taken, swap it in under
+ * the namespace lock, and copy a snapshot out only after dropping that lock.
+ * Ids are stored as kernel ids, translated from and to the caller's user
+ * namespace.  Existing endpoints are never re-checked.  Nothing here touches
+ * user memory.
  *
  * ns->policy is protected by the namespace lock (agnocast_ns.lock).
  */
@@ -160,18 +162,26 @@ static int agnocast_principal_in(struct agnocast_policy_principal_k *out,
 	return -EINVAL;
 }
 
-/* Copies a policy in from user space and validates it; no lock held. */
-static struct agnocast_policy_state *agnocast_policy_copy_in(const struct agnocast_policy *arg)
+/* Whether @arg's counts are within bounds: the caller may copy the arrays in. */
+bool agnocast_policy_arg_valid(const struct agnocast_policy *arg)
 {
-	struct agnocast_principal *principals = NULL;
-	struct agnocast_policy_rule *rules = NULL;
+	return !arg->reserved && arg->rule_count <= AGNOCAST_POLICY_RULES_MAX &&
+	       arg->principal_count <= AGNOCAST_POLICY_PRINCIPALS_MAX;
+}
+
+/*
+ * Builds a policy from its UAPI form (@arg, checked by
+ * agnocast_policy_arg_valid(), and the arrays it counts, copied in by the
+ * caller), validating every rule and principal; no lock held.
+ */
+struct agnocast_policy_state *agnocast_policy_build(const struct agnocast_policy *arg,
+						    const struct agnocast_policy_rule *rules,
+						    const struct agnocast_principal *principals)
+{
 	struct agnocast_policy_state *policy;
-	int ret = -EINVAL;
+	int ret = -ENOMEM;
 	u32 i;
 
-	if (arg->reserved || arg->rule_count > AGNOCAST_POLICY_RULES_MAX ||
-	    arg->principal_count > AGNOCAST_POLICY_PRINCIPALS_MAX)
-		return ERR_PTR(-EINVAL);
 	policy = kzalloc(sizeof(*policy), GFP_KERNEL_ACCOUNT);
 	if (!policy)
 		return ERR_PTR(-ENOMEM);
@@ -181,24 +191,8 @@ static struct agnocast_policy_state *agnocast_policy_copy_in(const struct agnoca
 	policy->rules = kvcalloc(arg->rule_count, sizeof(*policy->rules), GFP_KERNEL_ACCOUNT);
 	policy->principals = kvcalloc(arg->principal_count, sizeof(*policy->principals),
 				      GFP_KERNEL_ACCOUNT);
-	if ((arg->rule_count && !policy->rules) || (arg->principal_count && !policy->principals)) {
-		ret = -ENOMEM;
+	if ((arg->rule_count && !policy->rules) || (arg->principal_count && !policy->principals))
 		goto err_free;
-	}
-
-	rules = kvmalloc_array(arg->rule_count, sizeof(*rules), GFP_KERNEL_ACCOUNT);
-	principals = kvmalloc_array(arg->principal_count, sizeof(*principals), GFP_KERNEL_ACCOUNT);
-	if ((arg->rule_count && !rules) || (arg->principal_count && !principals)) {
-		ret = -ENOMEM;
-		goto err_free;
-	}
-	ret = -EFAULT;
-	if (copy_from_user(rules, u64_to_user_ptr(arg->rules),
-			   array_size(arg->rule_count, sizeof(*rules))) ||
-	    copy_from_user(principals, u64_to_user_ptr(arg->principals),
-			   array_size(arg->principal_count, sizeof(*principals))))
-		goto err_free;
-
 	for (i = 0; i < arg->rule_count; i++) {
 		ret = agnocast_rule_in(&policy->rules[i], &rules[i], arg->principal_count);
 		if (ret)
@@ -209,61 +203,19 @@ static struct agnocast_policy_state *agnocast_policy_copy_in(const struct agnoca
 		if (ret)
 			goto err_free;
 	}
-	kvfree(principals);
-	kvfree(rules);
 	return policy;
 
 err_free:
-	kvfree(principals);
-	kvfree(rules);
 	agnocast_policy_free(policy);
 	return ERR_PTR(ret);
 }
 
-int agnocast_set_policy(struct agnocast_ns *file_ns, void __user *uarg)
-{
-	struct agnocast_policy_state *policy = NULL, *old;
-	struct agnocast_policy arg;
-	struct agnocast_ctx ctx;
-	int ret;
-
-	if (!ns_capable(current->nsproxy->ipc_ns->user_ns, CAP_SYS_ADMIN))
-		return -EPERM;
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
-		return -EFAULT;
-	if (arg.flags & ~(AGNOCAST_POLICY_PRESENT | AGNOCAST_POLICY_DEFAULT_DENY))
-		return -EINVAL;
-	if (arg.flags & AGNOCAST_POLICY_PRESENT) {
-		policy = agnocast_policy_copy_in(&arg);
-		if (IS_ERR(policy))
-			return PTR_ERR(policy);
-	} else if (arg.flags || arg.rule_count || arg.principal_count || arg.reserved) {
-		return -EINVAL;
-	}
-
-	ret = agnocast_enter(&ctx, file_ns, false, true);
-	if (ret) {
-		agnocast_policy_free(policy);
-		return ret;
-	}
-	old = ctx.ns->policy;
-	ctx.ns->policy = policy;
-	agnocast_leave(&ctx);
-	agnocast_policy_free(old);
-	return 0;
-}
-
-/* Snapshot of a policy in UAPI form, made under the namespace lock. */
-struct agnocast_policy_copy {
-	u32 flags;
-	u32 nr_rules;
-	u32 nr_principals;
-	struct agnocast_policy_rule *rules;
-	struct agnocast_principal *principals;
-};
-
-static int agnocast_policy_copy_out(const struct agnocast_policy_state *policy,
-				    struct agnocast_policy_copy *copy)
+/*
+ * Snapshots @policy in UAPI form, ids as the caller's user namespace sees
+ * them (namespace lock held); agnocast_policy_copy_free() frees it.
+ */
+int agnocast_policy_snapshot(const struct agnocast_policy_state *policy,
+			     struct agnocast_policy_copy *copy)
 {
 	struct user_namespace *user_ns = current_user_ns();
 	u32 i;
@@ -275,7 +227,8 @@ static int agnocast_policy_copy_out(const struct agnocast_policy_state *policy,
 	copy->nr_rules = policy->nr_rules;
 	copy->nr_principals = policy->nr_principals;
 	copy->rules = kvcalloc(policy->nr_rules, sizeof(*copy->rules), GFP_KERNEL_ACCOUNT);
-	copy->principals = kvcalloc(policy->nr_principals, sizeof(*copy->principals), GFP_KERNEL_ACCOUNT);
+	copy->principals = kvcalloc(policy->nr_principals, sizeof(*copy->principals),
+				    GFP_KERNEL_ACCOUNT);
 	if ((policy->nr_rules && !copy->rules) || (policy->nr_principals && !copy->principals))
 		return -ENOMEM;
 	for (i = 0; i < policy->nr_rules; i++) {
@@ -300,47 +253,8 @@ static int agnocast_policy_copy_out(const struct agnocast_policy_state *policy,
 	return 0;
 }
 
-int agnocast_get_policy(struct agnocast_ns *file_ns, void __user *uarg)
+void agnocast_policy_copy_free(struct agnocast_policy_copy *copy)
 {
-	struct agnocast_policy_copy copy;
-	struct agnocast_policy arg;
-	struct agnocast_ctx ctx;
-	u32 rule_capacity, principal_capacity;
-	int ret;
-
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
-		return -EFAULT;
-	if (arg.reserved || arg.flags)
-		return -EINVAL;
-	rule_capacity = arg.rule_count;
-	principal_capacity = arg.principal_count;
-
-	ret = agnocast_enter(&ctx, file_ns, false, false);
-	if (ret)
-		return ret;
-	ret = agnocast_policy_copy_out(ctx.ns->policy, &copy);
-	agnocast_leave(&ctx);
-	if (ret)
-		goto out_free;
-
-	arg.flags = copy.flags;
-	arg.rule_count = copy.nr_rules;
-	arg.principal_count = copy.nr_principals;
-	ret = -EFAULT;
-	if (copy_to_user(uarg, &arg, sizeof(arg)))
-		goto out_free;
-	ret = -ENOSPC;
-	if (copy.nr_rules > rule_capacity || copy.nr_principals > principal_capacity)
-		goto out_free;
-	ret = -EFAULT;
-	if (copy_to_user(u64_to_user_ptr(arg.rules), copy.rules,
-			 array_size(copy.nr_rules, sizeof(*copy.rules))) ||
-	    copy_to_user(u64_to_user_ptr(arg.principals), copy.principals,
-			 array_size(copy.nr_principals, sizeof(*copy.principals))))
-		goto out_free;
-	ret = 0;
-out_free:
-	kvfree(copy.principals);
-	kvfree(copy.rules);
-	return ret;
+	kvfree(copy->principals);
+	kvfree(copy->rules);
 }

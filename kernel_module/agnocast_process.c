@@ -25,18 +25,14 @@
 #include <linux/bitmap.h>
 #include <linux/cred.h>
 #include <linux/hashtable.h>
-#include <linux/ipc_namespace.h>
 #include <linux/module.h>
-#include <linux/nsproxy.h>
 #include <linux/pid.h>
-#include <linux/pid_namespace.h>
 #include <linux/rculist.h>
 #include <linux/sched.h>
 #include <linux/sched/signal.h>
 #include <linux/slab.h>
 #include <linux/spinlock.h>
 #include <linux/tracepoint.h>
-#include <linux/uaccess.h>
 
 #include "agnocast_internal.h"
 
@@ -246,83 +242,44 @@ void agnocast_process_exit(void)
 	rcu_barrier();
 }
 
-/*
- * Takes the namespace lock (for write if @write), killably, and finds the
- * caller's registration.
- */
-int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns, bool registered,
-		   bool write)
+/* After exec, waits until the old program's registration is gone. */
+void agnocast_proc_settle_current(void)
 {
-	struct agnocast_proc *proc;
-	bool other_ns = false;
-	int ret;
-
-	ctx->proc = NULL;
-	ctx->write = write;
-	/* After exec, the old program's registration is gone before the new one calls. */
 	if (unlikely(agnocast_proc_pending(current->tgid)))
 		flush_workqueue(agnocast_wq);
-	/*
-	 * The open file holds a reference on the state of the namespace it was
-	 * opened in; while the caller is still in that namespace, use it and
-	 * skip the global namespace list.
-	 */
-	ctx->ns_from_file = file_ns && agnocast_ns_key_matches(file_ns);
-	ctx->ns = ctx->ns_from_file ? file_ns : agnocast_ns_get_current();
-	if (!ctx->ns)
-		return -ENOMEM;
-	ret = write ? down_write_killable(&ctx->ns->lock) : down_read_killable(&ctx->ns->lock);
-	if (ret) {
-		if (!ctx->ns_from_file)
-			agnocast_ns_put(ctx->ns);
-		return ret;
-	}
-
-	/* Under the namespace lock, a record of this namespace stays. */
-	rcu_read_lock();
-	proc = agnocast_proc_lookup(current->tgid);
-	if (proc && proc->ns != ctx->ns)
-		other_ns = true;
-	else
-		ctx->proc = proc;
-	rcu_read_unlock();
-
-	if (other_ns || (registered && !ctx->proc)) {
-		agnocast_leave(ctx);
-		return other_ns ? -EXDEV : -ESRCH;
-	}
-	return 0;
 }
 
-/* Drops the namespace lock; frees pools the call left ownerless and empty. */
-void agnocast_leave(struct agnocast_ctx *ctx)
-{
-	struct agnocast_ns *ns = ctx->ns;
-
-	if (ctx->write) {
-		if (ns->collect_pools)
-			agnocast_pools_collect(ns);
-		up_write(&ns->lock);
-	} else {
-		up_read(&ns->lock);
-		if (READ_ONCE(ns->collect_pools)) {
-			down_write(&ns->lock);
-			agnocast_pools_collect(ns);
-			up_write(&ns->lock);
-		}
-	}
-	if (!ctx->ns_from_file)
-		agnocast_ns_put(ns);
-}
-static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *err)
+/*
+ * The caller's registration in @ns, NULL if none (@ns->lock held, under which
+ * a record of the namespace stays); -EXDEV if it is registered in another.
+ */
+int agnocast_proc_find_current(struct agnocast_ns *ns, struct agnocast_proc **out)
 {
 	struct agnocast_proc *proc;
+	int ret = 0;
+
+	lockdep_assert_held(&ns->lock);
+	rcu_read_lock();
+	proc = agnocast_proc_lookup(current->tgid);
+	if (proc && proc->ns != ns) {
+		proc = NULL;
+		ret = -EXDEV;
+	}
+	rcu_read_unlock();
+	*out = proc;
+	return ret;
+}
+
+/* Registers the caller in @ns (lock held for write) with a reserved pool slot. */
+struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns)
+{
+	struct agnocast_proc *proc;
+	int err = -ENOMEM;
 
 	lockdep_assert_held_write(&ns->lock);
-	*err = -ENOMEM;
 	proc = kzalloc(sizeof(*proc), GFP_KERNEL_ACCOUNT);
 	if (!proc)
-		return NULL;
+		return ERR_PTR(-ENOMEM);
 	proc->given = bitmap_zalloc(agnocast_pool_count, GFP_KERNEL_ACCOUNT);
 	if (!proc->given)
 		goto err_free_proc;
@@ -331,11 +288,11 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 		goto err_free_given;
 	proc->pool = agnocast_pool_reserve(ns, proc);
 	if (IS_ERR(proc->pool)) {
-		*err = PTR_ERR(proc->pool);
+		err = PTR_ERR(proc->pool);
 		goto err_free_given;
 	}
 	if (!try_module_get(THIS_MODULE)) {
-		*err = -ENODEV;
+		err = -ENODEV;
 		goto err_free_pool;
 	}
 	proc->tgid = current->tgid;
@@ -353,7 +310,6 @@ static struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns, int *e
 	raw_spin_lock(&agnocast_proc_table_lock);
 	hash_add_rcu(agnocast_proc_table, &proc->table_node, proc->tgid);
 	raw_spin_unlock(&agnocast_proc_table_lock);
-	*err = 0;
 	return proc;
 
 err_free_pool:
@@ -364,58 +320,15 @@ err_free_given:
 	bitmap_free(proc->given);
 err_free_proc:
 	kfree(proc);
-	return NULL;
+	return ERR_PTR(err);
 }
 
-int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg)
+/* UNREGISTER_PROCESS: @proc goes as at exit, without exit records. */
+void agnocast_proc_unregister(struct agnocast_proc *proc)
 {
-	struct agnocast_register_process arg;
-	struct agnocast_ctx ctx;
-	int ret;
-
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
-		return -EFAULT;
-	if (arg.flags || arg.reserved)
-		return -EINVAL;
-	if (arg.pool_fd < -1)
-		return -EBADF;
-
-	ret = agnocast_enter(&ctx, file_ns, false, true);
-	if (ret)
-		return ret;
-	if (arg.pool_fd == -1) {
-		if (!ctx.proc)
-			ctx.proc = agnocast_proc_create(ctx.ns, &ret);
-	} else if (!ctx.proc) {
-		ret = -ESRCH;
-	} else {
-		ret = agnocast_pool_attach(ctx.proc->pool, arg.pool_fd);
-	}
-	if (ctx.proc && !ret) {
-		arg.pid = task_tgid_vnr(current);
-		arg.pool_addr = ctx.proc->pool->addr;
-		arg.pool_size = ctx.proc->pool->size;
-	}
-	agnocast_leave(&ctx);
-	if (ret)
-		return ret;
-	if (copy_to_user(uarg, &arg, sizeof(arg)))
-		return -EFAULT;
-	return 0;
-}
-
-int agnocast_unregister_process(struct agnocast_ns *file_ns)
-{
-	struct agnocast_ctx ctx;
-	int ret;
-
-	ret = agnocast_enter(&ctx, file_ns, true, true);
-	if (ret)
-		return ret;
+	lockdep_assert_held_write(&proc->ns->lock);
 	raw_spin_lock(&agnocast_proc_table_lock);
-	WRITE_ONCE(ctx.proc->dying, true);
+	WRITE_ONCE(proc->dying, true);
 	raw_spin_unlock(&agnocast_proc_table_lock);
-	agnocast_proc_teardown(ctx.proc, false);
-	agnocast_leave(&ctx);
-	return 0;
+	agnocast_proc_teardown(proc, false);
 }

@@ -228,14 +228,18 @@ bool agnocast_endpoint_args_valid(const struct agnocast_add_endpoint *arg, bool 
 		return false;
 	if (!arg->depth || arg->depth > AGNOCAST_DEPTH_MAX)
 		return false;
-	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL))
+	if (arg->flags & ~(AGNOCAST_TRANSIENT_LOCAL | AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL |
+			   AGNOCAST_WAKE_ONCE))
+		return false;
+	if ((arg->flags & AGNOCAST_WAKE_ONCE) && (arg->flags & AGNOCAST_POLLING))
 		return false;
 	if (!agnocast_str_terminated(arg->type_name, sizeof(arg->type_name)) ||
 	    !agnocast_type_name_valid(arg->type_name))
 		return false;
 	if (arg->schema_size > AGNOCAST_SCHEMA_MAX || arg->reserved)
 		return false;
-	return !(publisher && (arg->flags & (AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL)));
+	return !(publisher &&
+		 (arg->flags & (AGNOCAST_POLLING | AGNOCAST_IGNORE_LOCAL | AGNOCAST_WAKE_ONCE)));
 }
 
 /*
@@ -406,10 +410,10 @@ void agnocast_endpoint_destroy(struct agnocast_endpoint *ep)
 }
 
 /* The caller's publisher or subscriber @id of the topic @handle. */
-int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool publisher,
-			     struct agnocast_endpoint **out)
+int agnocast_endpoint_lookup(struct agnocast_ns *ns, struct agnocast_proc *proc, u32 handle,
+			     u32 id, bool publisher, struct agnocast_endpoint **out)
 {
-	struct agnocast_topic *topic = agnocast_topic_by_handle(ctx->ns, handle);
+	struct agnocast_topic *topic = agnocast_topic_by_handle(ns, handle);
 	struct agnocast_endpoint *ep;
 
 	if (!topic)
@@ -417,7 +421,7 @@ int agnocast_endpoint_lookup(struct agnocast_ctx *ctx, u32 handle, u32 id, bool 
 	ep = xa_load(&topic->endpoints, id);
 	if (!ep || ep->publisher != publisher)
 		return -ENOENT;
-	if (ep->proc != ctx->proc)
+	if (ep->proc != proc)
 		return -EPERM;
 	*out = ep;
 	return 0;

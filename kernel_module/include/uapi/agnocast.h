@@ -69,6 +69,18 @@
  * so they never take its depth.
  */
 #define AGNOCAST_IGNORE_LOCAL (1U << 2)
+/*
+ * Subscriber only, not with AGNOCAST_POLLING: woken once until it looks.  A
+ * PUBLISH lists it in wake_ids only if no PUBLISH did since its last RECEIVE
+ * (or TAKE, whatever either returned), so its publishers send it one
+ * notification between two of its RECEIVEs, however many entries they
+ * publish meanwhile.  Nothing waits unnoticed as long as the subscriber,
+ * once woken, RECEIVEs until `remaining` is 0 (taking the notification that
+ * woke it before or after): every entry published after that RECEIVE looked
+ * wakes it again.  A notification sent to a full queue may be dropped: one
+ * is waiting.
+ */
+#define AGNOCAST_WAKE_ONCE (1U << 4)
 
 /*
  * AGNOCAST_IOC_GET_VERSION: never fails but for -EFAULT.

@@ -13,6 +13,12 @@
  * pool is neither the caller's nor given to it.  Once the call commits, the
  * pools are marked given (agnocast_pool.c); a call that fails closes what it
  * installed.
+ *
+ * While no lock is held the entries can go (dropped for newer ones, shed,
+ * or released by a racing call) and their pool with them, its slot then
+ * reused by another pool at the same address.  Commit therefore hands over
+ * only the grants an entry of the call still needs: mapping a dead pool's
+ * file at its address would hide the live pool there from the caller.
  */
 #include <linux/fdtable.h>
 #include <linux/file.h>
@@ -50,6 +56,23 @@ bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_mempool
 	return true;
 }
 
+/* Sets installed grant @i aside, to be closed once no lock is held. */
+static void agnocast_grants_withhold(struct agnocast_grants *grants, u32 i)
+{
+	grants->withheld_files[grants->withheld] = grants->files[i];
+	grants->withheld_fds[grants->withheld++] = grants->out[i].fd;
+}
+
+/* Closes and puts the withheld grants; no lock held. */
+static void agnocast_grants_close_withheld(struct agnocast_grants *grants)
+{
+	while (grants->withheld) {
+		grants->withheld--;
+		close_fd(grants->withheld_fds[grants->withheld]);
+		fput(grants->withheld_files[grants->withheld]);
+	}
+}
+
 /*
  * TAKE's one grant: the installed descriptor of a pool the newest entry no
  * longer needs is closed once no lock is held (agnocast_grants_install()).
@@ -57,8 +80,7 @@ bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_mempool
 void agnocast_grants_add_over(struct agnocast_grants *grants, struct agnocast_mempool *pool)
 {
 	if (grants->count) {
-		grants->stale_fd = grants->out[0].fd;
-		grants->stale_file = grants->files[0];
+		agnocast_grants_withhold(grants, 0);
 		grants->count = 0;
 	}
 	agnocast_grants_add(grants, pool);
@@ -82,11 +104,7 @@ int agnocast_grants_install(struct agnocast_grants *grants, u32 from)
 	u32 i;
 	int fd;
 
-	if (grants->stale_file) {
-		close_fd(grants->stale_fd);
-		fput(grants->stale_file);
-		grants->stale_file = NULL;
-	}
+	agnocast_grants_close_withheld(grants);
 	for (i = from; i < grants->count; i++) {
 		fd = agnocast_receive_fd(grants->files[i]);
 		if (fd < 0)
@@ -104,19 +122,47 @@ err_undo:
 	return fd;
 }
 
-/* Marks the granted pools given (those still alive); namespace lock held. */
-void agnocast_grants_commit(struct agnocast_proc *proc, const struct agnocast_grants *grants)
+/* Whether one of @sub's unreceived entries @first..@first+@n-1 is in @file's pool. */
+static bool agnocast_grant_needed(const struct file *file, const struct agnocast_subscriber *sub,
+				  u32 first, u32 n)
 {
 	u32 i;
 
-	for (i = 0; i < grants->count; i++)
-		agnocast_pool_mark_given(proc, &grants->out[i], grants->files[i]);
+	for (i = first; i < first + n; i++) {
+		if (agnocast_sub_unreceived(sub, i)->pool->file == file)
+			return true;
+	}
+	return false;
 }
 
+/*
+ * Keeps, in order, the grants whose pool holds one of @sub's unreceived
+ * entries @first..@first+@n-1 (those the call hands over) and marks them
+ * given; withholds the others.  Namespace and topic locks held.
+ */
+void agnocast_grants_commit(struct agnocast_proc *proc, struct agnocast_grants *grants,
+			    const struct agnocast_subscriber *sub, u32 first, u32 n)
+{
+	u32 i, kept = 0;
+
+	for (i = 0; i < grants->count; i++) {
+		if (!agnocast_grant_needed(grants->files[i], sub, first, n)) {
+			agnocast_grants_withhold(grants, i);
+			continue;
+		}
+		agnocast_pool_mark_given(proc, &grants->out[i], grants->files[i]);
+		grants->files[kept] = grants->files[i];
+		grants->out[kept++] = grants->out[i];
+	}
+	grants->count = kept;
+}
+
+/* Drops the call's references; no lock held. */
 void agnocast_grants_put(struct agnocast_grants *grants)
 {
 	u32 i;
 
+	agnocast_grants_close_withheld(grants);
 	for (i = 0; i < grants->count; i++)
 		fput(grants->files[i]);
 }

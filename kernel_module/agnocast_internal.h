@@ -445,9 +445,14 @@ struct agnocast_grants {
 	struct agnocast_pool out[AGNOCAST_RECEIVE_POOLS_MAX];
 	u32 count;
 	u32 capacity;
-	/* TAKE: a grant replaced by another, to close and put unlocked. */
-	struct file *stale_file;
-	int stale_fd;
+	/*
+	 * Installed grants no entry of the call needs any more: TAKE's grant
+	 * replaced by another, or those commit withheld.  Closed and put with
+	 * no lock held.
+	 */
+	struct file *withheld_files[AGNOCAST_RECEIVE_POOLS_MAX];
+	int withheld_fds[AGNOCAST_RECEIVE_POOLS_MAX];
+	u32 withheld;
 };
 
 bool agnocast_grants_readable(const struct agnocast_proc *proc,
@@ -456,7 +461,8 @@ bool agnocast_grants_readable(const struct agnocast_proc *proc,
 bool agnocast_grants_add(struct agnocast_grants *grants, struct agnocast_mempool *pool);
 void agnocast_grants_add_over(struct agnocast_grants *grants, struct agnocast_mempool *pool);
 int agnocast_grants_install(struct agnocast_grants *grants, u32 from);
-void agnocast_grants_commit(struct agnocast_proc *proc, const struct agnocast_grants *grants);
+void agnocast_grants_commit(struct agnocast_proc *proc, struct agnocast_grants *grants,
+			    const struct agnocast_subscriber *sub, u32 first, u32 n);
 void agnocast_grants_put(struct agnocast_grants *grants);
 void agnocast_grants_close(struct agnocast_grants *grants);
 

@@ -375,7 +375,7 @@ relock:
 		goto out_unlock;
 
 	/* Commit: nothing below fails. */
-	agnocast_grants_commit(ctx.proc, &grants);
+	agnocast_grants_commit(ctx.proc, &grants, sub, 0, n);
 	agnocast_sub_receive(sub, entries, n);
 	arg.entry_count = n;
 	arg.pool_count = grants.count;
@@ -464,11 +464,14 @@ relock:
 		if (ret)
 			goto out_unlock;
 		/* Commit: nothing below fails. */
+		agnocast_grants_commit(ctx.proc, &grants, sub, sub->nr_unreceived - 1, 1);
 		agnocast_sub_take_newest(sub, &arg.entry);
 		arg.entry_count = 1;
+	} else {
+		/* What was installed for an entry that went since. */
+		agnocast_grants_commit(ctx.proc, &grants, sub, 0, 0);
 	}
 	if (grants.count) {
-		agnocast_grants_commit(ctx.proc, &grants);
 		arg.pool = grants.out[0];
 		arg.pool_count = 1;
 	}

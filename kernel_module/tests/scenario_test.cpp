@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
+#include <thread>
 
 #include "test_util.h"
 
@@ -196,6 +198,95 @@ TEST_F(Scenario, DeadPublishersSlotIsReusedWhileSubscriberLives) {
     ASSERT_TRUE(eventually([&] { return mapped_by_us() == 0; }));
   }
   munmap(view, slot_size);
+}
+
+// RECEIVE installs a pool's descriptor with no lock held. An entry that goes
+// meanwhile (dropped for a newer one from a pool the caller has) must take
+// its pool out of the answer: a dead pool's file mapped at its address would
+// hide the pool that gets its slot next. A thread publishes into the depth-1
+// subscription after a delay swept across attempts, so that some drops land
+// while the dead child's pool is being installed.
+TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {
+  constexpr int kAttempts = 200;
+  const std::string topic = "/stray_grant";
+  Endpoint sub, own;
+  ASSERT_EQ(add_subscriber(dev, topic, 1, &sub), 0);
+  ASSERT_EQ(add_publisher(dev, topic, 1, &own), 0);
+
+  // The delay (in spins) before the next drop; kIdle between attempts.
+  constexpr int kIdle = -1, kEnd = -2;
+  std::atomic<int> drop_after{kIdle};
+  std::atomic<int> drop_failures{0};
+  std::thread dropper([&] {
+    for (uint64_t i = 0;; i++) {
+      int spins;
+      while ((spins = drop_after.load()) == kIdle) sched_yield();
+      if (spins == kEnd) return;
+      for (int s = 0; s < spins; s++) __asm__ volatile("");
+      if (publish(dev, own, reg.addr + (i % 4096) * 64)) drop_failures++;
+      drop_after.store(kIdle);
+    }
+  });
+  struct StopDropper {
+    std::atomic<int>& drop_after;
+    std::thread& dropper;
+    ~StopDropper() {
+      while (drop_after.load() != kIdle) sched_yield();
+      drop_after.store(kEnd);
+      dropper.join();
+    }
+  } stop_dropper{drop_after, dropper};
+
+  int received_child = 0, pools_handed = 0;
+  auto check = [&](const ReceiveResult& rr, int attempt) {
+    for (const auto& pool : rr.pools) {
+      const bool holds = std::any_of(rr.entries.begin(), rr.entries.end(), [&](const auto& e) {
+        return e.addr >= pool.addr && e.addr < pool.addr + pool.size;
+      });
+      EXPECT_TRUE(holds) << "attempt " << attempt << ": the pool of pid " << pool.pid
+                         << " was handed over with none of the call's entries in it";
+      pools_handed++;
+      close(pool.fd);
+    }
+    for (const auto& e : rr.entries) {
+      if (e.addr < reg.addr || e.addr >= reg.addr + reg.size) received_child++;
+      EXPECT_EQ(release(dev, sub, e.entry_id), 0);
+    }
+  };
+  for (int attempt = 0; attempt < kAttempts && !HasFailure(); attempt++) {
+    Pipe ready;
+    pid_t child = fork();
+    if (child == 0) {
+      // Publishes one entry and dies: its pool lives as long as the entry.
+      int d = open_device();
+      Registration r;
+      Endpoint pub;
+      if (r.full(d) || add_publisher(d, topic, 1, &pub)) _exit(10);
+      *reinterpret_cast<volatile uint64_t*>(r.addr) = kMagic;
+      if (publish(d, pub, r.addr)) _exit(11);
+      ready.notify();
+      _exit(0);
+    }
+    ASSERT_TRUE(ready.wait());
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+
+    drop_after.store((attempt * 37) % 4000);
+    ReceiveResult rr;
+    ASSERT_EQ(receive(dev, sub, &rr, 1), 0);
+    while (drop_after.load() != kIdle) sched_yield();
+    check(rr, attempt);
+    ReceiveResult rest;
+    ASSERT_EQ(receive(dev, sub, &rest), 0);
+    check(rest, attempt);
+  }
+  EXPECT_EQ(drop_failures.load(), 0);
+  // Both outcomes must occur for the race to have been run at all.
+  std::printf("%d of %d children's entries received, %d pools handed over\n", received_child,
+              kAttempts, pools_handed);
+  EXPECT_GT(received_child, 0);
+  EXPECT_LT(received_child, kAttempts);
 }
 
 TEST_F(Scenario, SubscriberKilledMidStreamReleasesEverything) {

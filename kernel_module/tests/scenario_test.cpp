@@ -200,18 +200,34 @@ TEST_F(Scenario, DeadPublishersSlotIsReusedWhileSubscriberLives) {
   munmap(view, slot_size);
 }
 
-// RECEIVE installs a pool's descriptor with no lock held. An entry that goes
-// meanwhile (dropped for a newer one from a pool the caller has) must take
-// its pool out of the answer: a dead pool's file mapped at its address would
-// hide the pool that gets its slot next. A thread publishes into the depth-1
-// subscription after a delay swept across attempts, so that some drops land
-// while the dead child's pool is being installed.
-TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {
-  constexpr int kAttempts = 200;
-  const std::string topic = "/stray_grant";
+// TAKE, as a ReceiveResult of at most one entry and one pool.
+int take(int dev, Endpoint sub, ReceiveResult* res) {
+  agnocast_take arg{};
+  arg.topic_handle = sub.handle;
+  arg.subscriber_id = sub.id;
+  int ret = ioc(dev, AGNOCAST_IOC_TAKE, &arg);
+  if (!ret) {
+    res->entries.assign(&arg.entry, &arg.entry + arg.entry_count);
+    res->pools.assign(&arg.pool, &arg.pool + arg.pool_count);
+  }
+  return ret;
+}
+
+// RECEIVE and TAKE install a pool's descriptor with no lock held. An entry
+// that goes meanwhile (dropped for a newer one from a pool the caller has)
+// must take its pool out of the answer: a dead pool's file mapped at its
+// address would hide the pool that gets its slot next. A thread publishes
+// into the depth-1 subscription after a delay swept across attempts, so that
+// some drops land while the dead child's pool is being installed.
+void race_drop_against_install(int dev, const Registration& reg, bool polling) {
+  constexpr int kAttempts = 150;
+  const std::string topic = polling ? "/stray_grant_take" : "/stray_grant_receive";
   Endpoint sub, own;
-  ASSERT_EQ(add_subscriber(dev, topic, 1, &sub), 0);
+  ASSERT_EQ(add_subscriber(dev, topic, 1, &sub, polling ? AGNOCAST_POLLING : 0), 0);
   ASSERT_EQ(add_publisher(dev, topic, 1, &own), 0);
+  auto answer = [&](ReceiveResult* rr) {
+    return polling ? take(dev, sub, rr) : receive(dev, sub, rr, 1);
+  };
 
   // The delay (in spins) before the next drop; kIdle between attempts.
   constexpr int kIdle = -1, kEnd = -2;
@@ -253,7 +269,7 @@ TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {
       EXPECT_EQ(release(dev, sub, e.entry_id), 0);
     }
   };
-  for (int attempt = 0; attempt < kAttempts && !HasFailure(); attempt++) {
+  for (int attempt = 0; attempt < kAttempts && !::testing::Test::HasFailure(); attempt++) {
     Pipe ready;
     pid_t child = fork();
     if (child == 0) {
@@ -274,11 +290,11 @@ TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {
 
     drop_after.store((attempt * 37) % 4000);
     ReceiveResult rr;
-    ASSERT_EQ(receive(dev, sub, &rr, 1), 0);
+    ASSERT_EQ(answer(&rr), 0);
     while (drop_after.load() != kIdle) sched_yield();
     check(rr, attempt);
     ReceiveResult rest;
-    ASSERT_EQ(receive(dev, sub, &rest), 0);
+    ASSERT_EQ(answer(&rest), 0);
     check(rest, attempt);
   }
   EXPECT_EQ(drop_failures.load(), 0);
@@ -288,6 +304,12 @@ TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {
   EXPECT_GT(received_child, 0);
   EXPECT_LT(received_child, kAttempts);
 }
+
+TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {
+  race_drop_against_install(dev, reg, false);
+}
+
+TEST_F(Scenario, TakeHandsOverOnlyThePoolOfItsEntry) { race_drop_against_install(dev, reg, true); }
 
 TEST_F(Scenario, SubscriberKilledMidStreamReleasesEverything) {
   Endpoint pub;

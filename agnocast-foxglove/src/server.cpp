@@ -24,6 +24,8 @@
 #include "agnocast/schema_publisher.hpp"
 #include "agnocast/schema_subscription.hpp"
 #include "agnocast/signals.hpp"
+#include "agnocast_service/notify.hpp"
+#include "agnocast_service/watchdog.hpp"
 #include "protocol.hpp"
 
 namespace agnocast::foxglove {
@@ -136,9 +138,14 @@ class Server final : public WebSocketHandler {
     discover();  // the module's absence is an error before anyone connects
     const std::string& address = options_.websocket.address;
     const std::string host = address.find(':') == std::string::npos ? address : "[" + address + "]";
-    log("serving " + std::string(subprotocol) + " on ws://" + host + ":" +
-        std::to_string(websocket_.port()));
-    std::thread websocket_thread([this] { websocket_.run(); });
+    const std::string serving = "serving " + std::string(subprotocol) + " on ws://" + host + ":" +
+                                std::to_string(websocket_.port());
+    log(serving);
+    std::thread websocket_thread([this] {
+      websocket_.run();
+      websocket_running_ = false;
+    });
+    agnocast_service::notify("READY=1\nSTATUS=" + serving);
     try {
       auto next_discovery = std::chrono::steady_clock::now() + discovery_interval;
       while (agnocast::ok()) {
@@ -155,6 +162,7 @@ class Server final : public WebSocketHandler {
       throw;
     }
     log("stopping");
+    agnocast_service::notify("STOPPING=1");
     websocket_.stop();
     websocket_thread.join();
     clients_.clear();
@@ -477,7 +485,10 @@ class Server final : public WebSocketHandler {
   void forget_endpoint(const Subscription& subscription) { --ours_[subscription.kernel->topic()]; }
 
   void wait_and_receive() {
-    std::vector<pollfd> fds{{wake_fd_, POLLIN, 0}};
+    // The watchdog is pinged from this loop, and only while the WebSocket
+    // thread's loop runs too.
+    std::vector<pollfd> fds{{wake_fd_, POLLIN, 0}, {watchdog_.fd(), POLLIN, 0}};
+    constexpr std::size_t first_subscription = 2;
     std::vector<Subscription*> polled;
     for (auto& [id, client] : clients_) {
       bool full = false;
@@ -503,8 +514,13 @@ class Server final : public WebSocketHandler {
       std::uint64_t count = 0;
       [[maybe_unused]] const ssize_t read = ::read(wake_fd_, &count, sizeof count);
     }
-    for (std::size_t i = 1; i < fds.size(); ++i) {
-      if (fds[i].revents != 0) polled[i - 1]->kernel->receive();
+    if (fds[1].revents != 0) {
+      const bool healthy = websocket_running_;
+      watchdog_.tick(healthy);
+      if (!healthy) log("the WebSocket thread stopped; not pinging the watchdog");
+    }
+    for (std::size_t i = first_subscription; i < fds.size(); ++i) {
+      if (fds[i].revents != 0) polled[i - first_subscription]->kernel->receive();
     }
   }
 
@@ -598,6 +614,8 @@ class Server final : public WebSocketHandler {
   std::mutex commands_mutex_;
   std::vector<Command> commands_;
   std::atomic<std::size_t> publish_bytes_waiting_ = 0;
+  std::atomic<bool> websocket_running_ = true;
+  agnocast_service::Watchdog watchdog_;
 };
 
 }  // namespace

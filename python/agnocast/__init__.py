@@ -4,6 +4,7 @@ Messages live in the publishing process's shared pool; fields are read and
 written in place, and arrays of numbers are numpy arrays over that memory.
 Message types: ``from agnocast.msg.sensor_msgs import PointCloud2``.
 """
+import atexit
 import inspect
 import logging
 import pkgutil
@@ -58,8 +59,11 @@ def _log(level, text):
     _logger.log(_levels.get(level, logging.WARNING), text)
 
 
-# The library's warnings go to the logger "agnocast".
+# The library's warnings go to the logger "agnocast", from a thread of the
+# binding's own (the library may log while it holds a lock that a thread
+# with the GIL waits for); at exit, what is left is handed over first.
 _core.set_log_handler(_log)
+atexit.register(_core.set_log_handler, None)
 
 
 class MessageInfo:

@@ -28,6 +28,7 @@
 #include "agnocast/schema.hpp"
 #include "agnocast/schema_subscriber.hpp"
 #include "erased_message.hpp"
+#include "log_forwarder.hpp"
 
 namespace py = pybind11;
 
@@ -649,6 +650,31 @@ class PyPolling {
   detail::PollingCore core_;
 };
 
+// The Python log handler (agnocast/__init__.py passes logging's), touched
+// with the GIL held; the library's lines reach it through the forwarder.
+py::object& python_log_handler() {
+  static auto* handler = new py::object;
+  return *handler;
+}
+
+LogForwarder& log_forwarder() {
+  static auto* forwarder = new LogForwarder([](std::vector<LogLine>& lines) {
+    // While the interpreter goes away the lines are lost, as it cannot run them.
+    if (!Py_IsInitialized() || _Py_IsFinalizing()) return;
+    py::gil_scoped_acquire gil;
+    const py::object handler = python_log_handler();
+    if (!handler || handler.is_none()) return;
+    for (const LogLine& line : lines) {
+      try {
+        handler(static_cast<int>(line.level), decode(line.text));
+      } catch (py::error_already_set& e) {
+        e.discard_as_unraisable("agnocast log handler");
+      }
+    }
+  });
+  return *forwarder;
+}
+
 std::chrono::nanoseconds seconds(double value) {
   if (!(value > 0)) throw py::value_error("agnocast: the period must be positive seconds");
   return std::chrono::nanoseconds(static_cast<std::int64_t>(value * 1e9));
@@ -1020,21 +1046,22 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("type_hash"));
 
+  // handler(level, text) gets the library's lines from a thread of the
+  // forwarder (log_forwarder.hpp); None: back to stderr, once every line
+  // waiting was handed over.
   m.def("set_log_handler", [](py::object handler) {
     if (handler.is_none()) {
       set_log_handler(nullptr);
+      {
+        py::gil_scoped_release release;  // the forwarder's thread may wait for the GIL
+        log_forwarder().stop();
+      }
+      python_log_handler() = py::none();
       return;
     }
-    Callback held(std::move(handler));
-    set_log_handler([held](LogLevel level, std::string_view text) {
-      if (!Py_IsInitialized()) return;
-      py::gil_scoped_acquire gil;
-      try {
-        (*held)(static_cast<int>(level), py::str(text.data(), text.size()));
-      } catch (py::error_already_set& e) {
-        e.discard_as_unraisable("agnocast log handler");
-      }
-    });
+    python_log_handler() = std::move(handler);
+    set_log_handler(
+        [](LogLevel level, std::string_view text) { log_forwarder().post(level, text); });
   });
   m.attr("LOG_DEBUG") = static_cast<int>(LogLevel::debug);
   m.attr("LOG_INFO") = static_cast<int>(LogLevel::info);

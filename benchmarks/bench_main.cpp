@@ -314,8 +314,10 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   if (want_iceoryx && !iceoryx) {
     std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
   }
-  const std::optional<bench::PythonSubscriber> python = find_python(python_subscriber);
-  if (!python) {
+  const bool want_python = plan.selected("python_subscriber_constant_bytes");
+  const std::optional<bench::PythonSubscriber> python =
+      want_python ? find_python(python_subscriber) : std::nullopt;
+  if (want_python && !python) {
     std::cerr << "Python subscriber not found (" << python_subscriber.interpreter << " with numpy, "
               << python_subscriber.script << ", the agnocast package): skipped\n";
   }
@@ -440,11 +442,11 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       report["latency"][who][label] = stats;
     }
   }
-  if (!iceoryx) {
+  if (want_iceoryx && !iceoryx) {
     report["latency"]["iceoryx"] = nullptr;
     report["latency"]["iceoryx_constant_bytes"] = nullptr;
   }
-  if (!python) report["latency"]["python_subscriber_constant_bytes"] = nullptr;
+  if (want_python && !python) report["latency"]["python_subscriber_constant_bytes"] = nullptr;
   report["failed_cells"] = failed_cells;
   if (!plan.icount) {
     report["background"] = {

@@ -8,8 +8,12 @@
 #include <agnocast/agnocast.hpp>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <cstdlib>
 #include <iostream>
+#include <sensor_msgs/msg/point_cloud2.hpp>
 #include <span>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -155,6 +159,77 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
   munmap(shared, sizeof(std::atomic<std::uint32_t>));
   return per_subscriber;
+}
+
+std::vector<std::int64_t> run_python_latency(const PythonSubscriber& python, std::size_t size,
+                                             std::size_t count, std::size_t scratch_bytes) {
+  const std::string topic = next_topic("python");
+  const std::size_t total = warmup_messages + count;
+  Pipe ack = Pipe::open(), results = Pipe::open();
+  pid_t subscriber = spawn([&] {
+    ack.close_read();
+    results.close_read();
+    if (dup2(results.write_fd, STDOUT_FILENO) < 0) return 1;
+    setenv("PYTHONPATH", python.package_path.c_str(), 1);
+    setenv("PYTHONHASHSEED", "0", 1);  // the same work in every run (icount repeats)
+    const std::string count_text = std::to_string(total), size_text = std::to_string(size),
+                      ack_text = std::to_string(ack.write_fd);
+    execlp(python.interpreter.c_str(), python.interpreter.c_str(), python.script.c_str(),
+           topic.c_str(), count_text.c_str(), size_text.c_str(), ack_text.c_str(), nullptr);
+    std::cerr << "agnocast-bench: cannot run " << python.interpreter << "\n";
+    return 127;
+  });
+  results.close_write();
+  pid_t publisher = spawn([&] {
+    results.close_read();
+    ack.close_write();  // so that a subscriber gone ends its wait for an ack
+    agnocast::Node node{"bench_publisher"};
+    auto pub = node.create_publisher<sensor_msgs::msg::PointCloud2>(topic, agnocast::QoS{1});
+    // The interpreter starts and imports numpy meanwhile: seconds under emulation.
+    if (!pub->wait_for_subscribers(1, std::chrono::seconds(150))) {
+      throw std::runtime_error("the Python subscriber did not subscribe");
+    }
+    SharedScratch scratch(scratch_bytes);
+    for (std::size_t seq = 0; seq < total; ++seq) {
+      auto message = pub->borrow_loaned_message();
+      message->data.resize(size);
+      fill_payload(std::span(message->data.data(), size), seq);
+      fill_payload(scratch.bytes(), seq);
+      message->height = 1;
+      message->width = static_cast<std::uint32_t>(size);
+      message->point_step = 1;
+      message->header.stamp.sec = static_cast<std::int32_t>(seq);
+      message->header.stamp.nanosec = message->data[size - 1];  // what the subscriber checks
+      pub->publish(std::move(message));
+      read_bytes(ack.read_fd, 1);
+      settle_between_messages();
+    }
+    return 0;
+  });
+  ack.close_write();
+  std::string text;
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = ::read(results.read_fd, buffer, sizeof buffer);
+    if (n > 0) {
+      text.append(buffer, static_cast<std::size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  results.close_read();
+  ack.close_read();
+  reap(publisher, "publisher");
+  reap(subscriber, "Python subscriber");
+  std::vector<std::int64_t> latencies;
+  std::istringstream numbers(text);
+  for (std::int64_t latency; numbers >> latency;) {
+    if (latency < 0) throw std::runtime_error("python: a message arrived wrong");
+    latencies.push_back(latency);
+  }
+  if (latencies.size() != total) throw std::runtime_error("the Python subscriber missed messages");
+  latencies.erase(latencies.begin(), latencies.begin() + warmup_messages);
+  return latencies;
 }
 
 Throughput run_agnocast_throughput(std::size_t size, std::size_t count) {

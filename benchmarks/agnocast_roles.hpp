@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "bench_support.hpp"
@@ -24,6 +25,20 @@ namespace agnocast::bench {
 std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, std::size_t count,
                                                             std::size_t subscribers,
                                                             std::size_t scratch_bytes = 0);
+
+// How to start the Python subscriber (python_subscriber.py): the interpreter,
+// the script and the folder holding the agnocast package (PYTHONPATH).
+struct PythonSubscriber {
+  std::string interpreter;
+  std::string script;
+  std::string package_path;
+};
+// One-way latency of `count` sensor_msgs/PointCloud2 messages of `size` data
+// bytes from a C++ publisher to the callback of a Python subscription, one
+// message in flight, warm-up messages removed; as run_agnocast_latency, the
+// publisher writes scratch_bytes of private memory before each message.
+std::vector<std::int64_t> run_python_latency(const PythonSubscriber& python, std::size_t size,
+                                             std::size_t count, std::size_t scratch_bytes);
 
 struct Throughput {
   double messages_per_s = 0;

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
+#include <regex>
 
 #include "agnocast_roles.hpp"
 #include "baselines.hpp"
@@ -53,6 +54,13 @@ struct Plan {
   bool icount = false;
   // What the VM cannot see of where it runs, passed in by scripts/bench.
   std::string host_cpu, qemu_version, qemu_flags;
+  // Only the series whose names match (--series); empty: every series, and
+  // the rest of the report (cost breakdown, system calls, CPU, throughput,
+  // recording), which a selection leaves out.
+  std::string series;
+  bool selected(const std::string& who) const {
+    return series.empty() || std::regex_search(who, std::regex(series));
+  }
 
   void make_smoke() {
     smoke = true;
@@ -277,8 +285,20 @@ json cpu_json(const bench::CpuPerMessage& cpu) {
   return {{"publisher", cpu.publisher_us}, {"subscriber", cpu.subscriber_us}};
 }
 
+// The Python subscriber, when this system has it (the agnocast package built
+// and an interpreter with numpy: the VM gets both from scripts/bench).
+std::optional<bench::PythonSubscriber> find_python(bench::PythonSubscriber python) {
+  if (python.package_path.empty() || !std::filesystem::exists(python.script) ||
+      !std::filesystem::exists(python.package_path + "/agnocast")) {
+    return std::nullopt;
+  }
+  const std::string probe = python.interpreter + " -c 'import numpy' >/dev/null 2>&1";
+  if (std::system(probe.c_str()) != 0) return std::nullopt;
+  return python;
+}
+
 json run(const Plan& plan, const std::string& iceoryx_role, const std::string& breakdown_program,
-         const std::string& cli) {
+         const std::string& cli, const bench::PythonSubscriber& python_subscriber) {
   json report;
   report["mode"] = plan.icount ? "icount" : "ordinary";
   report["machine"] = machine_json();
@@ -288,8 +308,19 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   report["rounds"] = plan.rounds;
   report["seed"] = plan.seed;
 
-  std::optional<bench::IceoryxRunner> iceoryx = bench::IceoryxRunner::start(iceoryx_role);
-  if (!iceoryx) std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
+  const bool want_iceoryx = plan.selected("iceoryx") || plan.selected("iceoryx_constant_bytes");
+  std::optional<bench::IceoryxRunner> iceoryx =
+      want_iceoryx ? bench::IceoryxRunner::start(iceoryx_role) : std::nullopt;
+  if (want_iceoryx && !iceoryx) {
+    std::cerr << "iceoryx not found (iox-roudi or " << iceoryx_role << "): skipped\n";
+  }
+  const bool want_python = plan.selected("python_subscriber_constant_bytes");
+  const std::optional<bench::PythonSubscriber> python =
+      want_python ? find_python(python_subscriber) : std::nullopt;
+  if (want_python && !python) {
+    std::cerr << "Python subscriber not found (" << python_subscriber.interpreter << " with numpy, "
+              << python_subscriber.script << ", the agnocast package): skipped\n";
+  }
 
   // Every round runs every series briefly, in its own shuffled order, so a
   // slow spell of the emulator or of the host falls on a few series of one
@@ -344,6 +375,17 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       cells.push_back({"unix_socket_constant_bytes", label,
                        [=](auto&) { return bench::run_unix_socket_copy(size, m, scratch); }});
     }
+    // A C++ publisher to a Python callback, with the same 64 MiB written
+    // before each sample: the smallest and the largest size.
+    if (python) {
+      for (std::size_t size : {plan.sizes.front(), plan.sizes.back()}) {
+        const std::size_t scratch = bench::constant_written_bytes - size;
+        cells.push_back({"python_subscriber_constant_bytes", bench::format_size(size),
+                         [&, size, scratch](auto&) {
+                           return bench::run_python_latency(*python, size, m, scratch);
+                         }});
+      }
+    }
     for (std::size_t subscribers : plan.fanouts) {
       const std::string label = std::to_string(subscribers);
       cells.push_back({"agnocast_fanout", label, [&, subscribers](auto&) {
@@ -354,6 +396,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                          return bench::run_mqueue_fanout(subscribers, plan.fanout_samples);
                        }});
     }
+    std::erase_if(cells, [&](const Cell& cell) { return !plan.selected(cell.who); });
     std::shuffle(cells.begin(), cells.end(), shuffle);
     std::cerr << "round " << round + 1 << " of " << plan.rounds << ": " << cells.size()
               << " series, " << (bench::now_ns() - started_ns) / 1'000'000'000 << " s so far\n";
@@ -366,6 +409,8 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   }
 
   // Series in a fixed order, sizes and subscriber counts ascending.
+  const std::string smallest_label = bench::format_size(plan.sizes.front());
+  const std::string largest_label = bench::format_size(plan.sizes.back());
   std::vector<std::string> size_labels, fanout_labels;
   for (std::size_t size : plan.sizes) size_labels.push_back(bench::format_size(size));
   for (std::size_t subscribers : plan.fanouts) fanout_labels.push_back(std::to_string(subscribers));
@@ -378,6 +423,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       {"agnocast_constant_bytes", size_labels},
       {"iceoryx_constant_bytes", size_labels},
       {"unix_socket_constant_bytes", size_labels},
+      {"python_subscriber_constant_bytes", {smallest_label, largest_label}},
       {"agnocast_fanout", fanout_labels},
       {"mqueue_fanout", fanout_labels},
   };
@@ -396,10 +442,11 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       report["latency"][who][label] = stats;
     }
   }
-  if (!iceoryx) {
+  if (want_iceoryx && !iceoryx) {
     report["latency"]["iceoryx"] = nullptr;
     report["latency"]["iceoryx_constant_bytes"] = nullptr;
   }
+  if (want_python && !python) report["latency"]["python_subscriber_constant_bytes"] = nullptr;
   report["failed_cells"] = failed_cells;
   if (!plan.icount) {
     report["background"] = {
@@ -425,6 +472,11 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
        [&](std::size_t r) {
          return p50(r, "agnocast_constant_bytes", largest) /
                 p50(r, "agnocast_constant_bytes", smallest);
+       }},
+      {"python_size_flatness", 1.05, 1.01,
+       [&](std::size_t r) {
+         return p50(r, "python_subscriber_constant_bytes", largest) /
+                p50(r, "python_subscriber_constant_bytes", smallest);
        }},
       {"size_flatness_iceoryx", 1.05, 1.01,
        [&](std::size_t r) {
@@ -497,6 +549,8 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                          {"mqueue", slope(all_rounds, "mqueue_fanout")}}
                   : json{{"agnocast", bench::median(agnocast_slopes)},
                          {"mqueue", bench::median(mqueue_slopes)}};
+
+  if (!plan.series.empty()) return report;  // a selection: its series only
 
   std::cerr << "the cost of one message, call by call...\n";
   json breakdown = cost_breakdown(breakdown_program, plan.smoke);
@@ -579,6 +633,8 @@ int main(int argc, char** argv) {
   std::string iceoryx_role = (here / "agnocast-bench-iceoryx").string();
   std::string breakdown_program = (here / "agnocast-bench-breakdown").string();
   std::string cli = (here / "agnocast-cli").string();
+  bench::PythonSubscriber python{AGNOCAST_BENCH_PYTHON, (here / "python_subscriber.py").string(),
+                                 AGNOCAST_BENCH_PYTHON_PATH};
   Plan plan;
   app.add_flag("--json", json_output, "print one JSON object instead of Markdown tables");
   app.add_flag("--smoke", smoke,
@@ -591,6 +647,12 @@ int main(int argc, char** argv) {
   app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
   app.add_option("--breakdown-program", breakdown_program, "the cost breakdown program");
   app.add_option("--cli", cli, "the agnocast-cli program, whose bag record is measured");
+  app.add_option("--python", python.interpreter, "the Python interpreter of the Python series");
+  app.add_option("--python-path", python.package_path,
+                 "the folder holding the agnocast Python package (PYTHONPATH)");
+  app.add_option("--series", plan.series,
+                 "run only the latency series whose names match this regular expression (e.g. "
+                 "python_subscriber), and nothing else of the report");
   app.add_flag("--icount", plan.icount,
                "the VM runs in QEMU's instruction-counting mode: fewer rounds, single-valued "
                "ratios, no series that needs parallel cores");
@@ -644,7 +706,7 @@ int main(int argc, char** argv) {
   if (smoke) plan.make_smoke();
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
   try {
-    json report = run(plan, iceoryx_role, breakdown_program, cli);
+    json report = run(plan, iceoryx_role, breakdown_program, cli, python);
     if (json_output) {
       std::cout << report.dump() << "\n";
     } else {

@@ -201,10 +201,13 @@ std::vector<std::string> report_shape_errors(const json& report) {
   for (const char* who : {"agnocast_fanout", "mqueue_fanout"}) {
     for (const char* subscribers : {"1", "8", "64"}) check.latency(who, subscribers);
   }
+  for (const char* size : {"64 B", "64 MiB"})
+    check.latency("python_subscriber_constant_bytes", size);
   // The slope's difference of p50s may be negative in a tiny smoke run, so
   // fanout_slope is only required to be there.
-  for (const char* name : {"size_flatness", "size_flatness_iceoryx", "vs_iceoryx", "vs_iceoryx_64",
-                           "vs_mqueue_floor", "vs_epoll_floor", "fanout_64"}) {
+  for (const char* name :
+       {"size_flatness", "size_flatness_iceoryx", "python_size_flatness", "vs_iceoryx",
+        "vs_iceoryx_64", "vs_mqueue_floor", "vs_epoll_floor", "fanout_64"}) {
     check.ratio(name, icount);
   }
   check.at({"ratios", "fanout_slope"});
@@ -303,6 +306,15 @@ void print_markdown(const json& report) {
     }
   }
 
+  if (latency.contains("python_subscriber_constant_bytes")) {
+    std::printf(
+        "\n| one-way latency, %s (p50 / p99), C++ publisher to a Python callback, 64 MiB "
+        "written before each sample | 64 B | 64 MiB |\n|---|---|---|\n"
+        "| `sensor_msgs/PointCloud2`, read in place through numpy | %s | %s |\n",
+        unit, cell(latency, "python_subscriber_constant_bytes", "64 B").c_str(),
+        cell(latency, "python_subscriber_constant_bytes", "64 MiB").c_str());
+  }
+
   std::printf(
       "\n| publish to last delivery, %s (p50 / p99) | agnocast, 4 KiB | mqueue wake-ups, "
       "receivers in `epoll_wait` |\n|---|---|---|\n",
@@ -336,6 +348,9 @@ void print_markdown(const json& report) {
     std::printf("| `%s` | %s | %s | ≤ %s | %s |\n", name.c_str(), number(value).c_str(),
                 range.c_str(), number(report["targets"][name], "%g").c_str(), met_text);
   }
+
+  // A run of selected series (agnocast-bench --series) has nothing more.
+  if (!report.contains("throughput")) return;
 
   std::printf(
       "\n| system calls per message (counted) | publisher | subscriber | publisher's "
@@ -531,7 +546,12 @@ asleep before each sample. The floors are timed the same way, from `mq_send`
 to the receiver's return from `mq_receive`, the receiver waiting in
 `mq_receive` (`vs_mqueue_floor`) or in `epoll_wait` first, as agnocast's
 executor does (`vs_epoll_floor`). The size series write 64 MiB before every
-sample (payload + scratch), for every size and transport. System calls are
+sample (payload + scratch), for every size and transport. The Python series
+times a C++ publisher of `sensor_msgs/PointCloud2` to the first line of a
+Python subscription's callback (`time.monotonic_ns()` against the publish time
+the library stamps), which then checks the message through the numpy view of
+the publisher's memory; `python_size_flatness` is its 64 MiB p50 over its 64 B
+p50. System calls are
 counted (perf counters on the syscall tracepoints) in a run of their own;
 CPU time per message (user + system, 1 message a millisecond) is taken
 without counters for agnocast, iceoryx and the floor alike. iceoryx is
@@ -600,6 +620,10 @@ depend on it.
   std::printf("- `size_flatness` ≤ 1.01: %s (iceoryx: %s)\n",
               standing(at_path(icount, {"ratios", "size_flatness"}), 1.01, "%.3f").c_str(),
               number(at_path(icount, {"ratios", "size_flatness_iceoryx"}), "%.3f").c_str());
+  std::printf(
+      "- a 64 MiB message reaches a Python callback as fast as 64 B "
+      "(`python_size_flatness` ≤ 1.01): %s\n",
+      standing(at_path(icount, {"ratios", "python_size_flatness"}), 1.01, "%.3f").c_str());
   const json& cpu = icount["cpu_us_per_message"];
   for (const char* side : {"publisher", "subscriber"}) {
     const json& ours = at_path(cpu, {"agnocast", side});
@@ -629,6 +653,10 @@ depend on it.
   std::printf("- `size_flatness` ≤ 1.05: %s\n",
               standing(at_path(ordinary, {"ratios", "size_flatness"}), 1.05, "%.2f",
                        at_path(ordinary, {"ratio_ci", "size_flatness"}))
+                  .c_str());
+  std::printf("- `python_size_flatness` ≤ 1.05: %s\n",
+              standing(at_path(ordinary, {"ratios", "python_size_flatness"}), 1.05, "%.2f",
+                       at_path(ordinary, {"ratio_ci", "python_size_flatness"}))
                   .c_str());
   std::printf("- `vs_iceoryx` ≤ 1.0 on the 64 MiB-written series (64 B): %s\n",
               standing(at_path(ordinary, {"ratios", "vs_iceoryx_constant_bytes"}), 1.0, "%.2f",

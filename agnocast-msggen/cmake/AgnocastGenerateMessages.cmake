@@ -72,20 +72,23 @@ function(agnocast_generate_messages target)
     list(APPEND include_options --include ${include})
   endforeach()
 
+  # The names of the package's constants, for its Python module.
+  set(constant_list ${output_dir}/agnocast_constants.inc)
   add_custom_command(
-    OUTPUT ${headers}
+    OUTPUT ${headers} ${constant_list}
     COMMAND $<TARGET_FILE:${generator}> --package ${arg_PACKAGE} --output-dir ${output_dir} ${include_options}
-            ${inputs}
+            --constant-list ${constant_list} ${inputs}
     DEPENDS ${inputs} ${dependency_files} ${generator}
     COMMENT "Generating agnocast messages of ${arg_PACKAGE}"
     VERBATIM)
-  add_library(${target} INTERFACE ${headers})
+  add_library(${target} INTERFACE ${headers} ${constant_list})
   target_include_directories(${target} INTERFACE $<BUILD_INTERFACE:${output_dir}>)
   target_link_libraries(${target} INTERFACE agnocast::agnocast ${dependency_targets})
   set_target_properties(${target} PROPERTIES
     AGNOCAST_MSG_INCLUDES "${includes}"
     AGNOCAST_PACKAGE ${arg_PACKAGE}
     AGNOCAST_MSG_FILES "${inputs}"
+    AGNOCAST_CONSTANT_LIST ${constant_list}
     AGNOCAST_HEADER_DIR ${output_dir})
   if(arg_PYTHON)
     agnocast_python_messages(${target}_python OUTPUT_DIR ${output_dir}/python PACKAGES ${target})

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "constant_list_writer.hpp"
 #include "header_writer.hpp"
 #include "message_set.hpp"
 
@@ -32,11 +33,14 @@ int main(int argc, char** argv) {
   std::filesystem::path output;
   std::vector<std::string> includes;
   std::vector<std::filesystem::path> files;
+  std::filesystem::path constant_list;
   app.add_option("--package", package, "package of the input messages")->required();
   app.add_option("--output-dir", output, "headers go to DIR/<package>/msg/<name>.hpp")->required();
   app.add_option("--include", includes,
                  "PKG=DIR: where the .msg files of a package the inputs refer to are")
       ->allow_extra_args(false);
+  app.add_option("--constant-list", constant_list,
+                 "also writes FILE: AGNOCAST_CONSTANT(Message, NAME) per constant of the inputs");
   app.add_option("files", files, ".msg files of the package")->required();
   try {
     app.parse(argc, argv);
@@ -59,6 +63,9 @@ int main(int argc, char** argv) {
     for (const msggen::MessageSpec& spec : messages.inputs()) {
       write_if_changed(output / msggen::header_path(spec.package, spec.name),
                        msggen::write_header(spec));
+    }
+    if (!constant_list.empty()) {
+      write_if_changed(constant_list, msggen::write_constant_list(messages.inputs()));
     }
   } catch (const std::exception& error) {
     std::cerr << "agnocast-msggen: " << error.what() << "\n";

@@ -5,7 +5,7 @@ import sys
 import numpy as np
 
 import agnocast
-from agnocast.msg.sensor_msgs import PointCloud2
+from agnocast.msg.sensor_msgs import PointCloud2, PointField
 
 
 def main(count):
@@ -20,7 +20,7 @@ def main(count):
         for i, name in enumerate("xyz"):
             msg.fields[i].name = name
             msg.fields[i].offset = 4 * i
-            msg.fields[i].datatype = 7  # FLOAT32
+            msg.fields[i].datatype = PointField.FLOAT32
             msg.fields[i].count = 1
         msg.data.resize(1000 * 12)
         points = np.asarray(msg.data).view(np.float32).reshape(1000, 3)  # the pool memory

@@ -4,6 +4,7 @@ Messages live in the publishing process's shared pool; fields are read and
 written in place, and arrays of numbers are numpy arrays over that memory.
 Message types: ``from agnocast.msg.sensor_msgs import PointCloud2``.
 """
+import atexit
 import inspect
 import logging
 import pkgutil
@@ -15,10 +16,11 @@ __path__ = pkgutil.extend_path(__path__, __name__)
 from . import _core
 from ._core import (  # noqa: F401  (re-exported)
     AccessDenied,
+    CallbackGroup,
+    CallbackGroupType,
     DeviceError,
     Error,
     Executor,
-    Message,
     MessagePublished,
     MessageType,
     ModuleNotLoaded,
@@ -39,6 +41,8 @@ from ._core import (  # noqa: F401  (re-exported)
     VersionMismatch,
 )
 
+from ._message import Message, MessageMeta  # noqa: F401  (re-exported)
+
 # The topic access policy's refusal, under the name other frameworks use.
 PermissionDenied = AccessDenied
 
@@ -55,8 +59,11 @@ def _log(level, text):
     _logger.log(_levels.get(level, logging.WARNING), text)
 
 
-# The library's warnings go to the logger "agnocast".
+# The library's warnings go to the logger "agnocast", from a thread of the
+# binding's own (the library may log while it holds a lock that a thread
+# with the GIL waits for); at exit, what is left is handed over first.
 _core.set_log_handler(_log)
+atexit.register(_core.set_log_handler, None)
 
 
 class MessageInfo:
@@ -73,6 +80,21 @@ class MessageInfo:
     def __repr__(self):
         return (f"MessageInfo(publisher_id={self.publisher_id}, entry_id={self.entry_id}, "
                 f"publish_time={self.publish_time}, bytes={self.bytes})")
+
+
+class MutuallyExclusiveCallbackGroup(CallbackGroup):
+    """Callbacks of the group never run at the same time, whatever the executor's threads."""
+
+    def __init__(self):
+        super().__init__(CallbackGroupType.MutuallyExclusive)
+
+
+class ReentrantCallbackGroup(CallbackGroup):
+    """Callbacks of the group may run in parallel on a MultiThreadedExecutor (a
+    subscription still delivers its own messages one at a time, in order)."""
+
+    def __init__(self):
+        super().__init__(CallbackGroupType.Reentrant)
 
 
 def _qos(qos):
@@ -115,8 +137,9 @@ class Node(_core.Node):
         return Publisher(self, _message_type(msg_type), topic, _qos(qos))
 
     def create_subscription(self, msg_type, topic, qos, callback, *,
-                            ignore_local_publications=False):
-        """callback(msg) or callback(msg, info): runs in the executor spinning this node."""
+                            ignore_local_publications=False, callback_group=None):
+        """callback(msg) or callback(msg, info): runs in the executor spinning this node,
+        in callback_group (None: the node's default group, mutually exclusive)."""
         if _takes_info(callback):
             def deliver(message, info):
                 callback(message, MessageInfo(**info))
@@ -124,7 +147,7 @@ class Node(_core.Node):
             def deliver(message, _info):
                 callback(message)
         subscription = Subscription(self, _message_type(msg_type), topic, _qos(qos), deliver,
-                                    ignore_local_publications)
+                                    ignore_local_publications, callback_group)
         self._entities.append(subscription)
         return subscription
 
@@ -133,20 +156,31 @@ class Node(_core.Node):
         return PollingSubscriber(self, _message_type(msg_type), topic, _qos(qos),
                                  ignore_local_publications)
 
-    def create_wall_timer(self, period_sec, callback):
-        """callback() every period_sec seconds (steady clock), from the executor."""
-        timer = Timer(self, float(period_sec), callback)
+    def create_wall_timer(self, period_sec, callback, callback_group=None):
+        """callback() every period_sec seconds (steady clock), from the executor,
+        in callback_group (None: the node's default group)."""
+        timer = Timer(self, float(period_sec), callback, callback_group)
         self._entities.append(timer)
         return timer
 
     create_timer = create_wall_timer
 
     def destroy_subscription(self, subscription):
+        """Lets the subscription go: it is removed once no callback of it runs
+        (at once, unless an executor is running one) and no reference is left."""
         self._entities.remove(subscription)
 
     def destroy_timer(self, timer):
         timer.cancel()
         self._entities.remove(timer)
+
+    def destroy_node(self):
+        """Lets go every subscription and timer of the node (as destroy_subscription
+        and destroy_timer); an executor spinning the node finds nothing left to run."""
+        for entity in self._entities:
+            if isinstance(entity, Timer):
+                entity.cancel()
+        self._entities.clear()
 
 
 def spin(node, executor=None):

@@ -28,6 +28,7 @@
 #include "agnocast/schema.hpp"
 #include "agnocast/schema_subscriber.hpp"
 #include "erased_message.hpp"
+#include "log_forwarder.hpp"
 
 namespace py = pybind11;
 
@@ -192,6 +193,39 @@ struct Message {
     set_field(storage, base, target, value);
   }
 };
+
+// The Python classes of the message types, by layout hash (agnocast._message
+// registers each class it makes). Touched only with the GIL held.
+std::unordered_map<std::uint64_t, py::object>& python_classes() {
+  static auto* map = new std::unordered_map<std::uint64_t, py::object>;
+  return *map;
+}
+
+// agnocast._core.Message.__init__, which makes an instance of a message class
+// share a core message's memory (set when the module loads).
+py::object& core_message_init() {
+  static auto* init = new py::object;
+  return *init;
+}
+
+// The message as an instance of its type's class (PointCloud2, Header, ...).
+py::object to_python(Message message) {
+  const SchemaType& type = message.type();
+  auto& known = python_classes();
+  auto found = known.find(type.hash);
+  if (found == known.end()) {
+    // A nested type whose module was not imported: _message makes its class.
+    py::module_::import("agnocast._message").attr("class_for")(type.name, type.hash);
+    found = known.find(type.hash);
+    if (found == known.end()) return py::cast(std::move(message));
+  }
+  // Made as Python makes an instance, but without the class's own __init__,
+  // which would borrow a new message.
+  const py::object& cls = found->second;
+  py::object object = cls.attr("__new__")(cls);
+  core_message_init()(object, py::cast(std::move(message)));
+  return object;
+}
 
 // A sequence or fixed array field: numbers (buffer protocol, numpy views),
 // strings or messages.
@@ -405,7 +439,7 @@ py::object field_value(const std::shared_ptr<Storage>& storage, std::byte* base,
   const ErasedOps& ops = storage->cls->ops;
   if (field.shape == FieldShape::Single) {
     if (field.kind == FieldKind::String) return decode(ops.string_at(at));
-    if (field.kind == FieldKind::Message) return py::cast(Message{storage, at, field.nested});
+    if (field.kind == FieldKind::Message) return to_python(Message{storage, at, field.nested});
     return read_number(at, field.kind);
   }
   if (field.shape == FieldShape::Array && is_primitive(field.kind)) {
@@ -497,34 +531,38 @@ detail::MessageType type_of(const MessageClass* cls) {
   return detail::MessageType{cls->type().name, cls->type().hash, cls->schema.blob()};
 }
 
+// A new message in this process's pool with the .msg file's default values:
+// a loan any publisher of its type may publish.
+Message new_loan(const MessageClass* cls) {
+  const SchemaType& type = cls->type();
+  void* memory = detail::allocate_message(type.size, type.align, &destroy_erased);
+  try {
+    cls->ops.construct(memory, 0);
+    if (!cls->defaults.empty()) {
+      cls->apply_defaults(static_cast<std::byte*>(memory),
+                          reinterpret_cast<const std::byte*>(cls->defaults.data()), 0);
+    }
+  } catch (...) {
+    detail::free_message_memory(memory);
+    throw;
+  }
+  {
+    std::lock_guard lock(class_mutex());
+    loans().emplace(memory, cls);
+  }
+  auto storage = std::make_shared<Storage>();
+  storage->cls = cls;
+  storage->message = memory;
+  storage->loan = true;
+  return Message{storage, static_cast<std::byte*>(memory), 0};
+}
+
 class PyPublisher {
  public:
   PyPublisher(const Node& node, const MessageClass* cls, const std::string& topic, const QoS& qos)
       : cls_(cls), core_(node.state(), topic, qos, type_of(cls)) {}
 
-  Message borrow() {
-    const SchemaType& type = cls_->type();
-    void* memory = detail::allocate_message(type.size, type.align, &destroy_erased);
-    try {
-      cls_->ops.construct(memory, 0);
-      if (!cls_->defaults.empty()) {
-        cls_->apply_defaults(static_cast<std::byte*>(memory),
-                             reinterpret_cast<const std::byte*>(cls_->defaults.data()), 0);
-      }
-    } catch (...) {
-      detail::free_message_memory(memory);
-      throw;
-    }
-    {
-      std::lock_guard lock(class_mutex());
-      loans().emplace(memory, cls_);
-    }
-    auto storage = std::make_shared<Storage>();
-    storage->cls = cls_;
-    storage->message = memory;
-    storage->loan = true;
-    return Message{storage, static_cast<std::byte*>(memory), 0};
-  }
+  py::object borrow() { return to_python(new_loan(cls_)); }
 
   void publish(const Message& message) {
     Storage& storage = *message.storage;
@@ -579,7 +617,7 @@ class PySubscription : public detail::SubscriptionBase {
                const MessageInfo& info) override {
     py::gil_scoped_acquire gil;
     Message view = received(cls_, message, reference);  // owns the reference from here
-    (*callback_)(py::cast(std::move(view)), info_dict(info));
+    (*callback_)(to_python(std::move(view)), info_dict(info));
   }
 
   const MessageClass* cls_;
@@ -599,7 +637,7 @@ class PyPolling {
       taken = only_new ? core_.take_new() : core_.take_latest();
     }
     if (!taken.message) return py::none();
-    return py::cast(received(cls_, taken.message, taken.reference));
+    return to_python(received(cls_, taken.message, taken.reference));
   }
   std::size_t publisher_count() const {
     py::gil_scoped_release release;
@@ -611,6 +649,31 @@ class PyPolling {
   const MessageClass* cls_;
   detail::PollingCore core_;
 };
+
+// The Python log handler (agnocast/__init__.py passes logging's), touched
+// with the GIL held; the library's lines reach it through the forwarder.
+py::object& python_log_handler() {
+  static auto* handler = new py::object;
+  return *handler;
+}
+
+LogForwarder& log_forwarder() {
+  static auto* forwarder = new LogForwarder([](std::vector<LogLine>& lines) {
+    // While the interpreter goes away the lines are lost, as it cannot run them.
+    if (!Py_IsInitialized() || _Py_IsFinalizing()) return;
+    py::gil_scoped_acquire gil;
+    const py::object handler = python_log_handler();
+    if (!handler || handler.is_none()) return;
+    for (const LogLine& line : lines) {
+      try {
+        handler(static_cast<int>(line.level), decode(line.text));
+      } catch (py::error_already_set& e) {
+        e.discard_as_unraisable("agnocast log handler");
+      }
+    }
+  });
+  return *forwarder;
+}
 
 std::chrono::nanoseconds seconds(double value) {
   if (!(value > 0)) throw py::value_error("agnocast: the period must be positive seconds");
@@ -703,13 +766,13 @@ PYBIND11_MODULE(_core, m) {
                (qos.is_transient_local() ? ", transient_local=True)" : ")");
       });
 
-  py::class_<MessageClass, std::unique_ptr<MessageClass, py::nodelete>>(m, "MessageType",
-                                                                        py::dynamic_attr())
+  py::class_<MessageClass, std::unique_ptr<MessageClass, py::nodelete>>(m, "MessageType")
       .def(py::init([](py::bytes blob, py::bytes defaults) {
              return const_cast<MessageClass*>(message_class(blob, defaults));
            }),
            py::arg("schema"), py::arg("defaults") = py::bytes())
       .def_property_readonly("type_name", [](const MessageClass& c) { return c.type().name; })
+      .def("new_message", [](const MessageClass& c) { return py::cast(new_loan(&c)); })
       .def("__repr__",
            [](const MessageClass& c) { return "<agnocast message type " + c.type().name + ">"; })
       .def_property_readonly("type_hash", [](const MessageClass& c) { return c.type().hash; })
@@ -743,7 +806,10 @@ PYBIND11_MODULE(_core, m) {
 
   py::class_<Keeper>(m, "_Keeper");
 
+  // The base of the message classes (agnocast.Message in _message.py); its
+  // constructor only takes another core message, whose memory it shares.
   py::class_<Message>(m, "Message")
+      .def(py::init([](const Message& memory) { return memory; }), py::arg("memory"))
       .def("__getattr__", &Message::get)
       .def("__setattr__", &Message::set)
       .def("__dir__",
@@ -781,6 +847,8 @@ PYBIND11_MODULE(_core, m) {
         return out + ")";
       });
 
+  core_message_init() = m.attr("Message").attr("__init__");
+
   py::class_<Sequence>(m, "Sequence", py::buffer_protocol())
       .def("__len__", &Sequence::length)
       .def("resize", &Sequence::resize, py::arg("count"))
@@ -790,7 +858,7 @@ PYBIND11_MODULE(_core, m) {
              std::byte* at = s.element(i);
              if (s.field->kind == FieldKind::String) return decode(s.ops().string_at(at));
              if (s.field->kind == FieldKind::Message) {
-               return py::cast(Message{s.storage, at, s.field->nested});
+               return to_python(Message{s.storage, at, s.field->nested});
              }
              return read_number(at, s.field->kind);
            })
@@ -859,9 +927,18 @@ PYBIND11_MODULE(_core, m) {
         return "Sequence(" + std::to_string(s.length()) + " elements)";
       });
 
+  py::enum_<CallbackGroupType>(m, "CallbackGroupType")
+      .value("MutuallyExclusive", CallbackGroupType::MutuallyExclusive)
+      .value("Reentrant", CallbackGroupType::Reentrant);
+  py::class_<CallbackGroup, std::shared_ptr<CallbackGroup>>(m, "CallbackGroup")
+      .def(py::init<CallbackGroupType>(), py::arg("type"))
+      .def_property_readonly("type", &CallbackGroup::type);
+
   py::class_<Node, std::shared_ptr<Node>>(m, "Node")
       .def(py::init<std::string>(), py::arg("name"))
-      .def("get_name", &Node::get_name);
+      .def("get_name", &Node::get_name)
+      .def("create_callback_group", &Node::create_callback_group, py::arg("type"))
+      .def_property_readonly("default_callback_group", &Node::get_default_callback_group);
 
   py::class_<PyPublisher, std::shared_ptr<PyPublisher>>(m, "Publisher")
       .def(py::init([](const Node& node, const MessageClass& cls, const std::string& topic,
@@ -879,10 +956,11 @@ PYBIND11_MODULE(_core, m) {
 
   py::class_<PySubscription, std::shared_ptr<PySubscription>>(m, "Subscription")
       .def(py::init([](const Node& node, const MessageClass& cls, const std::string& topic,
-                       const QoS& qos, py::object callback, bool ignore_local) {
+                       const QoS& qos, py::object callback, bool ignore_local,
+                       std::shared_ptr<CallbackGroup> group) {
              SubscriptionOptions options;
              options.ignore_local_publications = ignore_local;
-             options.callback_group = detail::group_or_default(*node.state(), nullptr);
+             options.callback_group = detail::group_or_default(*node.state(), std::move(group));
              Callback held(std::move(callback));
              std::shared_ptr<PySubscription> subscription;
              {
@@ -894,7 +972,7 @@ PYBIND11_MODULE(_core, m) {
              return subscription;
            }),
            py::arg("node"), py::arg("type"), py::arg("topic"), py::arg("qos"), py::arg("callback"),
-           py::arg("ignore_local_publications") = false)
+           py::arg("ignore_local_publications") = false, py::arg("callback_group") = nullptr)
       .def("get_publisher_count", &PySubscription::publisher_count)
       .def_property_readonly("topic_name", &PySubscription::topic);
 
@@ -914,15 +992,19 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("topic_name", &PyPolling::topic);
 
   py::class_<Timer, std::shared_ptr<Timer>>(m, "Timer")
-      .def(py::init([](Node& node, double period, py::object callback) {
+      .def(py::init([](Node& node, double period, py::object callback,
+                       std::shared_ptr<CallbackGroup> group) {
              Callback held(std::move(callback));
              auto run = [held] {
                py::gil_scoped_acquire gil;
                (*held)();
              };
-             return node.create_wall_timer(seconds(period), std::move(run));
+             const auto interval = seconds(period);
+             py::gil_scoped_release release;
+             return node.create_wall_timer(interval, std::move(run), std::move(group));
            }),
-           py::arg("node"), py::arg("period"), py::arg("callback"))
+           py::arg("node"), py::arg("period"), py::arg("callback"),
+           py::arg("callback_group") = nullptr)
       .def("cancel", &Timer::cancel)
       .def("reset", &Timer::reset)
       .def("is_canceled", &Timer::is_canceled)
@@ -930,8 +1012,12 @@ PYBIND11_MODULE(_core, m) {
           "period", [](const Timer& t) { return static_cast<double>(t.period().count()) * 1e-9; });
 
   py::class_<Executor>(m, "Executor")
-      .def("add_node", &Executor::add_node, py::arg("node"), py::keep_alive<1, 2>())
-      .def("remove_node", &Executor::remove_node, py::arg("node"))
+      // Without the GIL, as every call that may wait for a lock of the library:
+      // the executor's threads take the GIL to run callbacks.
+      .def("add_node", &Executor::add_node, py::arg("node"), py::keep_alive<1, 2>(),
+           py::call_guard<py::gil_scoped_release>())
+      .def("remove_node", &Executor::remove_node, py::arg("node"),
+           py::call_guard<py::gil_scoped_release>())
       .def("spin", [](Executor& e) { without_gil([&] { e.spin(); }); })
       .def("spin_some", [](Executor& e) { without_gil([&] { e.spin_some(); }); })
       .def(
@@ -948,21 +1034,34 @@ PYBIND11_MODULE(_core, m) {
   py::class_<MultiThreadedExecutor, Executor>(m, "MultiThreadedExecutor")
       .def(py::init<std::size_t>(), py::arg("num_threads") = 0);
 
+  m.def(
+      "register_class",
+      [](std::uint64_t hash, py::object cls) { python_classes()[hash] = std::move(cls); },
+      py::arg("type_hash"), py::arg("cls"));
+  m.def(
+      "registered_class",
+      [](std::uint64_t hash) -> py::object {
+        const auto found = python_classes().find(hash);
+        return found == python_classes().end() ? py::none() : found->second;
+      },
+      py::arg("type_hash"));
+
+  // handler(level, text) gets the library's lines from a thread of the
+  // forwarder (log_forwarder.hpp); None: back to stderr, once every line
+  // waiting was handed over.
   m.def("set_log_handler", [](py::object handler) {
     if (handler.is_none()) {
       set_log_handler(nullptr);
+      {
+        py::gil_scoped_release release;  // the forwarder's thread may wait for the GIL
+        log_forwarder().stop();
+      }
+      python_log_handler() = py::none();
       return;
     }
-    Callback held(std::move(handler));
-    set_log_handler([held](LogLevel level, std::string_view text) {
-      if (!Py_IsInitialized()) return;
-      py::gil_scoped_acquire gil;
-      try {
-        (*held)(static_cast<int>(level), py::str(text.data(), text.size()));
-      } catch (py::error_already_set& e) {
-        e.discard_as_unraisable("agnocast log handler");
-      }
-    });
+    python_log_handler() = std::move(handler);
+    set_log_handler(
+        [](LogLevel level, std::string_view text) { log_forwarder().post(level, text); });
   });
   m.attr("LOG_DEBUG") = static_cast<int>(LogLevel::debug);
   m.attr("LOG_INFO") = static_cast<int>(LogLevel::info);

@@ -1,18 +1,21 @@
 """The Python binding against the kernel module and C++ endpoints (run in the VM).
 
 The C++ side is python_peer (python_peer.cpp), found on PATH."""
+import gc
 import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
 import pytest
 
 import agnocast
-from agnocast.msg.sensor_msgs import PointCloud2
-from agnocast.msg.std_msgs import String
+from agnocast.msg.builtin_interfaces import Time
+from agnocast.msg.sensor_msgs import PointCloud2, PointField
+from agnocast.msg.std_msgs import Header, String
 from agnocast.msg.wheel_msgs import Wheel
 
 
@@ -324,3 +327,234 @@ def test_a_new_message_has_the_msg_files_default_values():
     assert (pose.orientation.x, pose.orientation.w, pose.position.z) == (0.0, 1.0, 0.0)
     status = node.create_publisher(NavSatStatus, "/py/fix_status", 1).borrow_loaned_message()
     assert status.status == -2
+
+
+def test_messages_are_instances_of_their_classes():
+    node = agnocast.Node("py_classes")
+    got = []
+    sub = node.create_subscription(PointCloud2, "/py/classes", 10, got.append)
+    pub = node.create_publisher(PointCloud2, "/py/classes", 10)
+    loan = pub.borrow_loaned_message()
+    assert isinstance(loan, PointCloud2) and isinstance(loan, agnocast.Message)
+    assert type(loan) is PointCloud2 and type(loan).__name__ == "PointCloud2"
+    assert not isinstance(loan, String)
+    assert isinstance(loan.header, Header) and isinstance(loan.header.stamp, Time)
+    loan.fields.resize(1)
+    assert type(loan.fields[0]) is PointField
+    loan.fields[0].datatype = PointField.FLOAT32
+    assert loan.fields[0].datatype == 7 and loan.fields[0].FLOAT64 == 8
+    loan.width = 1
+    pub.publish(loan)
+    # A message made by its class is a loan of this process's pool too.
+    made = PointCloud2(height=2, width=3)
+    assert type(made) is PointCloud2 and (made.height, made.width) == (2, 3)
+    made.header.frame_id = "made"
+    with pytest.raises(AttributeError):
+        PointCloud2(no_such_field=1)
+    pub.publish(made)
+    with pytest.raises(agnocast.MessagePublished):
+        made.width
+    spin_until(node, lambda: len(got) == 2)
+    first, second = got
+    assert type(first) is PointCloud2 and isinstance(second, PointCloud2)
+    assert isinstance(second.header, Header) and second.header.frame_id == "made"
+    assert type(first.fields[0]).__name__ == "PointField"
+    assert not first._writable
+    with pytest.raises(agnocast.ReadOnlyMessage):
+        first.width = 2
+    # A class of another type is refused on the topic, by the kernel as before.
+    with pytest.raises(agnocast.TypeMismatch):
+        node.create_subscription(String, "/py/classes", 10, got.append)
+    with pytest.raises(TypeError):
+        node.create_publisher(String, "/py/classes_string", 1).publish(PointCloud2())
+    node.destroy_subscription(sub)
+
+
+NESTED_CLASS_IMPORTED_WHEN_NEEDED = """
+import sys
+from agnocast.msg.wheel_msgs import Wheel
+assert "agnocast.msg.geometry_msgs" not in sys.modules
+message = Wheel()
+message.forces.resize(1)
+force = message.forces[0]
+assert type(force).__name__ == "Vector3", type(force)
+from agnocast.msg.geometry_msgs import Vector3
+assert isinstance(force, Vector3)
+print("ok")
+"""
+
+
+def test_a_nested_message_gets_its_packages_class_without_an_import():
+    out = subprocess.run([sys.executable, "-c", NESTED_CLASS_IMPORTED_WHEN_NEEDED],
+                         stdout=subprocess.PIPE, text=True, timeout=120, check=True).stdout
+    assert out.strip() == "ok"
+
+
+def spans_of_two_timers(group_a, group_b):
+    """Runs two timers whose callbacks sleep (the GIL released) on a
+    MultiThreadedExecutor of 4 threads for a second: (start, end) of each run."""
+    node = agnocast.Node("py_groups")
+    spans = {"a": [], "b": []}
+
+    def work(name):
+        def callback():
+            started = time.monotonic()
+            time.sleep(0.1)
+            spans[name].append((started, time.monotonic()))
+        return callback
+
+    node.create_wall_timer(0.02, work("a"), callback_group=group_a)
+    node.create_wall_timer(0.02, work("b"), callback_group=group_b)
+    executor = agnocast.MultiThreadedExecutor(4)
+    executor.add_node(node)
+    node.create_wall_timer(1.0, executor.cancel,
+                           callback_group=agnocast.MutuallyExclusiveCallbackGroup())
+    executor.spin()
+    executor.remove_node(node)
+    node.destroy_node()
+    assert len(spans["a"]) >= 2 and len(spans["b"]) >= 2, spans
+    return spans
+
+
+def overlapping(spans):
+    runs = sorted(spans["a"] + spans["b"])
+    return sum(1 for earlier, later in zip(runs, runs[1:]) if later[0] < earlier[1])
+
+
+def test_a_mutually_exclusive_group_never_runs_two_callbacks_at_once():
+    group = agnocast.MutuallyExclusiveCallbackGroup()
+    assert overlapping(spans_of_two_timers(group, group)) == 0
+    assert overlapping(spans_of_two_timers(None, None)) == 0  # the node's default group
+
+
+def test_a_reentrant_group_runs_callbacks_in_parallel():
+    group = agnocast.ReentrantCallbackGroup()
+    assert overlapping(spans_of_two_timers(group, group)) > 0
+    # Two mutually exclusive groups of their own overlap each other as well.
+    assert overlapping(spans_of_two_timers(agnocast.MutuallyExclusiveCallbackGroup(),
+                                           agnocast.MutuallyExclusiveCallbackGroup())) > 0
+
+
+def publish_text(pub, text):
+    msg = pub.borrow_loaned_message()
+    msg.data = text
+    pub.publish(msg)
+
+
+def wait_for(condition, timeout=30.0):
+    deadline = time.monotonic() + timeout
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return condition()
+
+
+class SlowSubscriber:
+    """A subscription whose callback blocks until released, on a
+    MultiThreadedExecutor spinning in a thread of its own."""
+
+    def __init__(self, topic, group=None):
+        self.node = agnocast.Node("py_slow")
+        self.entered, self.release, self.seen = threading.Event(), threading.Event(), []
+        self.sub = self.node.create_subscription(String, topic, 10, self.callback,
+                                                 callback_group=group)
+        self.pub = agnocast.Node("py_fast").create_publisher(String, topic, 10)
+        self.executor = agnocast.MultiThreadedExecutor(2)
+        self.executor.add_node(self.node)
+        self.spinner = threading.Thread(target=self.executor.spin)
+        self.spinner.start()
+
+    def callback(self, msg):
+        self.seen.append(msg.data)
+        self.entered.set()
+        assert self.release.wait(60)
+
+    def stop(self):
+        self.release.set()
+        self.executor.cancel()
+        self.spinner.join(60)
+        assert not self.spinner.is_alive(), "the executor did not stop"
+
+
+def test_destroying_a_subscription_while_another_thread_runs_its_callback():
+    slow = SlowSubscriber("/py/destroy_sub", agnocast.ReentrantCallbackGroup())
+    try:
+        publish_text(slow.pub, "one")
+        assert slow.entered.wait(30)
+        slow.node.destroy_subscription(slow.sub)
+        del slow.sub
+        gc.collect()  # the Python side lets go while the callback still runs
+        slow.release.set()
+        # The executor drops it when the callback returns: gone from the topic.
+        assert wait_for(lambda: slow.pub.get_subscription_count() == 0)
+        publish_text(slow.pub, "two")
+        time.sleep(0.3)
+        assert slow.seen == ["one"]
+    finally:
+        slow.stop()
+
+
+def test_destroying_the_node_while_another_thread_runs_its_callback():
+    slow = SlowSubscriber("/py/destroy_node")
+    try:
+        ticks = []
+        slow.node.create_wall_timer(0.01, lambda: ticks.append(1),
+                                    callback_group=agnocast.ReentrantCallbackGroup())
+        publish_text(slow.pub, "one")
+        assert slow.entered.wait(30)
+        slow.node.destroy_node()
+        del slow.sub
+        gc.collect()
+        slow.release.set()
+        assert wait_for(lambda: slow.pub.get_subscription_count() == 0)
+        ticks_after = len(ticks)
+        publish_text(slow.pub, "two")
+        time.sleep(0.3)
+        assert slow.seen == ["one"] and len(ticks) == ticks_after
+    finally:
+        slow.stop()
+
+
+def test_destroying_a_subscription_and_a_node_from_inside_their_callbacks():
+    node = agnocast.Node("py_self_destroy")
+    pub = node.create_publisher(String, "/py/self_destroy", 10)
+    seen = []
+    subs = []
+
+    def once(msg):
+        seen.append(msg.data)
+        node.destroy_subscription(subs.pop())
+
+    subs.append(node.create_subscription(String, "/py/self_destroy", 10, once))
+    publish_text(pub, "one")
+    spin_until(node, lambda: seen)
+    assert wait_for(lambda: pub.get_subscription_count() == 0)
+    publish_text(pub, "two")
+    agnocast.spin_once(node, 0.3)
+    assert seen == ["one"]
+
+    # The whole node, from a callback on a MultiThreadedExecutor that goes on spinning.
+    doomed = agnocast.Node("py_doomed")
+    executor = agnocast.MultiThreadedExecutor(2)
+    last = []
+
+    def teardown(msg):
+        last.append(msg.data)
+        doomed.destroy_node()
+        executor.remove_node(doomed)
+
+    doomed.create_subscription(String, "/py/doomed", 10, teardown)
+    executor.add_node(doomed)
+    spinner = threading.Thread(target=executor.spin)
+    spinner.start()
+    try:
+        doomed_pub = node.create_publisher(String, "/py/doomed", 10)
+        publish_text(doomed_pub, "bye")
+        assert wait_for(lambda: last == ["bye"])
+        assert wait_for(lambda: doomed_pub.get_subscription_count() == 0)
+        publish_text(doomed_pub, "again")
+        time.sleep(0.3)
+        assert last == ["bye"]
+    finally:
+        executor.cancel()
+        spinner.join(60)
+    assert not spinner.is_alive()

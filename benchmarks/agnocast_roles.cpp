@@ -8,6 +8,7 @@
 #include <agnocast/agnocast.hpp>
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <iostream>
 #include <span>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include "allocation_counter.hpp"
 #include "bench_support.hpp"
 #include "syscall_counter.hpp"
+#include "window_counters.hpp"
 
 namespace agnocast::bench {
 namespace {
@@ -89,6 +91,13 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
                       MAP_SHARED | MAP_ANONYMOUS, -1, 0);
   if (shared == MAP_FAILED) throw std::runtime_error("mmap failed");
   auto* delivered = new (shared) std::atomic<std::uint32_t>(0);
+  // The first subscriber's CPU time from the end of one callback to the start
+  // of the next: its wait and the library's path to the callback.
+  void* cpu_memory = mmap(nullptr, sizeof(std::int64_t), PROT_READ | PROT_WRITE,
+                          MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (cpu_memory == MAP_FAILED) throw std::runtime_error("mmap failed");
+  auto* receiver_cpu = new (cpu_memory) std::int64_t(-1);
+  const bool measure_cpu = std::getenv("AGNOCAST_BENCH_WINDOWS") != nullptr;
   std::vector<Pipe> results;
   std::vector<pid_t> subscriber_pids;
   for (std::size_t s = 0; s < subscribers; ++s) {
@@ -97,11 +106,15 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
     subscriber_pids.push_back(spawn([&, results_fd] {
       std::vector<std::int64_t> latencies;
       latencies.reserve(total);
+      std::int64_t cpu_after_callback = measure_cpu ? thread_cpu_time_ns() : 0;
       agnocast::SingleThreadedExecutor executor;
       agnocast::Node node{"bench_subscriber"};
       auto subscription = node.create_subscription<BenchMessage>(
           topic, agnocast::QoS{10}, [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
             std::int64_t t1 = now_ns();
+            if (measure_cpu && results_fd == results.front().write_fd) {
+              *receiver_cpu = thread_cpu_time_ns() - cpu_after_callback;
+            }
             bool intact = m->payload.size() == size &&
                           payload_intact(std::span(m->payload.data(), m->payload.size()), m->seq);
             latencies.push_back(intact ? t1 - m->t0_ns : -1);
@@ -110,6 +123,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
               write_all(ack.write_fd, &byte, 1);
             }
             if (latencies.size() == total) executor.cancel();
+            if (measure_cpu) cpu_after_callback = thread_cpu_time_ns();
           });
       executor.add_node(node);
       char byte = 1;
@@ -124,6 +138,8 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
     auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{1});
     read_bytes(ready.read_fd, subscribers);
     SharedScratch scratch(scratch_bytes);
+    SampleWindows windows("agnocast size=" + std::to_string(size) +
+                          " scratch=" + std::to_string(scratch_bytes));
     for (std::size_t seq = 0; seq < total; ++seq) {
       auto message = pub->borrow_loaned_message();
       message->payload.resize(size);
@@ -131,9 +147,12 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
       fill_payload(scratch.bytes(), seq);
       message->seq = seq;
       delivered->store(0);
+      windows.before_send();
       message->t0_ns = now_ns();
       pub->publish(std::move(message));
+      windows.sent();
       read_bytes(ack.read_fd, 1);
+      windows.after_ack(seq, *receiver_cpu);
       settle_between_messages();
     }
     return 0;
@@ -154,6 +173,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   reap(publisher, "publisher");
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
   munmap(shared, sizeof(std::atomic<std::uint32_t>));
+  munmap(cpu_memory, sizeof(std::int64_t));
   return per_subscriber;
 }
 

@@ -8,7 +8,6 @@
 #include <agnocast/agnocast.hpp>
 #include <atomic>
 #include <cerrno>
-#include <cstdlib>
 #include <iostream>
 #include <span>
 #include <stdexcept>
@@ -91,13 +90,6 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
                       MAP_SHARED | MAP_ANONYMOUS, -1, 0);
   if (shared == MAP_FAILED) throw std::runtime_error("mmap failed");
   auto* delivered = new (shared) std::atomic<std::uint32_t>(0);
-  // The first subscriber's CPU time from the end of one callback to the start
-  // of the next: its wait and the library's path to the callback.
-  void* cpu_memory = mmap(nullptr, sizeof(std::int64_t), PROT_READ | PROT_WRITE,
-                          MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-  if (cpu_memory == MAP_FAILED) throw std::runtime_error("mmap failed");
-  auto* receiver_cpu = new (cpu_memory) std::int64_t(-1);
-  const bool measure_cpu = std::getenv("AGNOCAST_BENCH_WINDOWS") != nullptr;
   std::vector<Pipe> results;
   std::vector<pid_t> subscriber_pids;
   for (std::size_t s = 0; s < subscribers; ++s) {
@@ -106,15 +98,11 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
     subscriber_pids.push_back(spawn([&, results_fd] {
       std::vector<std::int64_t> latencies;
       latencies.reserve(total);
-      std::int64_t cpu_after_callback = measure_cpu ? thread_cpu_time_ns() : 0;
       agnocast::SingleThreadedExecutor executor;
       agnocast::Node node{"bench_subscriber"};
       auto subscription = node.create_subscription<BenchMessage>(
           topic, agnocast::QoS{10}, [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
             std::int64_t t1 = now_ns();
-            if (measure_cpu && results_fd == results.front().write_fd) {
-              *receiver_cpu = thread_cpu_time_ns() - cpu_after_callback;
-            }
             bool intact = m->payload.size() == size &&
                           payload_intact(std::span(m->payload.data(), m->payload.size()), m->seq);
             latencies.push_back(intact ? t1 - m->t0_ns : -1);
@@ -123,7 +111,6 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
               write_all(ack.write_fd, &byte, 1);
             }
             if (latencies.size() == total) executor.cancel();
-            if (measure_cpu) cpu_after_callback = thread_cpu_time_ns();
           });
       executor.add_node(node);
       char byte = 1;
@@ -152,7 +139,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
       pub->publish(std::move(message));
       windows.sent();
       read_bytes(ack.read_fd, 1);
-      windows.after_ack(seq, *receiver_cpu);
+      windows.after_ack(seq);
       settle_between_messages();
     }
     return 0;
@@ -173,7 +160,6 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   reap(publisher, "publisher");
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
   munmap(shared, sizeof(std::atomic<std::uint32_t>));
-  munmap(cpu_memory, sizeof(std::int64_t));
   return per_subscriber;
 }
 

@@ -11,7 +11,6 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -99,17 +98,13 @@ std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait,
   // from mq_receive, on the shared monotonic clock.  Half the round trip
   // would average in the pong leg, whose sender is already awake.
   auto* arrivals = map_shared<std::int64_t>(count);
-  auto* receiver_cpu = map_shared<std::int64_t>(count);
   pid_t echo = fork();
   if (echo == 0) {
     FloorReceiver receiver(ping, wait);
-    const bool measure_cpu = std::getenv("AGNOCAST_BENCH_WINDOWS") != nullptr;
     char byte = 0;
     for (std::size_t i = 0; i < count; ++i) {
-      const std::int64_t cpu0 = measure_cpu ? thread_cpu_time_ns() : 0;
       if (!receiver.receive()) _exit(1);
       arrivals[i] = now_ns();
-      receiver_cpu[i] = measure_cpu ? thread_cpu_time_ns() - cpu0 : -1;
       if (mq_send(pong, &byte, 1, 0) != 0) _exit(1);
     }
     _exit(0);
@@ -130,13 +125,12 @@ std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait,
     if (!sent || mq_receive(pong, &byte, 1, nullptr) != 1) {
       throw std::system_error(errno, std::generic_category(), "mqueue ping-pong");
     }
-    windows.after_ack(i, receiver_cpu[i]);
+    windows.after_ack(i);
     one_way.push_back(arrivals[i] - t0);
     settle_between_messages();
   }
   wait_for(echo);
   munmap(arrivals, count * sizeof(std::int64_t));
-  munmap(receiver_cpu, count * sizeof(std::int64_t));
   mq_close(ping);
   mq_close(pong);
   mq_unlink(ping_name.c_str());

@@ -41,12 +41,6 @@ std::int64_t cpu_time_ns() {
   return ns(usage.ru_utime) + ns(usage.ru_stime);
 }
 
-std::int64_t thread_cpu_time_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 CpuPerMessage per_message(std::int64_t publisher_ns, std::int64_t subscriber_ns,
                           std::size_t messages) {
   const double n = static_cast<double>(messages);

@@ -24,10 +24,6 @@ void sleep_until_ns(std::int64_t deadline_ns);
 // User + system CPU time this process has used, in nanoseconds.
 std::int64_t cpu_time_ns();
 
-// CPU time the calling thread has used, in nanoseconds: a wait that spins
-// adds to it, one that sleeps does not.
-std::int64_t thread_cpu_time_ns();
-
 // Bytes written before each sample besides the payload, so that every payload
 // size is preceded by the same number of written bytes (payload +
 // scratch = 64 MiB).  Shared memory (a memfd), the kind the zero-copy

@@ -35,16 +35,5 @@ TEST(BenchSupport, SharedScratchIsWritableSharedMemoryOfTheAskedSize) {
   EXPECT_TRUE(SharedScratch(0).bytes().empty());
 }
 
-TEST(BenchSupport, ThreadCpuTimeGrowsWhileBusyAndNotWhileAsleep) {
-  const std::int64_t before_sleep = thread_cpu_time_ns();
-  sleep_until_ns(now_ns() + 50'000'000);
-  const std::int64_t asleep = thread_cpu_time_ns() - before_sleep;
-  EXPECT_LT(asleep, 10'000'000);  // the sleep's 50 ms are not CPU time
-  const std::int64_t before_work = thread_cpu_time_ns();
-  volatile std::uint64_t sink = 0;
-  while (thread_cpu_time_ns() - before_work < 20'000'000) sink = sink + 1;
-  EXPECT_GE(thread_cpu_time_ns() - before_work, 20'000'000);
-}
-
 }  // namespace
 }  // namespace agnocast::bench

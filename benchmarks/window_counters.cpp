@@ -149,7 +149,7 @@ void SampleWindows::sent() {
   if (timed_) send_ns_ = now_ns() - start_ns_;
 }
 
-void SampleWindows::after_ack(std::uint64_t seq, std::int64_t receiver_cpu_ns) {
+void SampleWindows::after_ack(std::uint64_t seq) {
   if (!timed_) return;
   const std::int64_t acked_ns = now_ns() - start_ns_;
   const std::vector<std::int64_t> delta =
@@ -157,7 +157,6 @@ void SampleWindows::after_ack(std::uint64_t seq, std::int64_t receiver_cpu_ns) {
   std::string line = "window " + who_ + " seq=" + std::to_string(seq) +
                      " cpu=" + std::to_string(cpu_) + " send_ns=" + std::to_string(send_ns_) +
                      " acked_ns=" + std::to_string(acked_ns);
-  if (receiver_cpu_ns >= 0) line += " receiver_cpu_ns=" + std::to_string(receiver_cpu_ns);
   for (std::size_t i = 0; i < delta.size(); ++i) {
     line += " " + counters_->names()[i] + "=" + std::to_string(delta[i]);
   }

@@ -49,9 +49,7 @@ class SampleWindows {
   explicit SampleWindows(std::string who);
   void before_send();
   void sent();
-  // `receiver_cpu_ns`: the receiver's CPU time from going to sleep to
-  // having the message, when the role measured it (< 0: not measured).
-  void after_ack(std::uint64_t seq, std::int64_t receiver_cpu_ns = -1);
+  void after_ack(std::uint64_t seq);
 
  private:
   std::string who_;

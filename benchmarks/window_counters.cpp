@@ -138,19 +138,13 @@ SampleWindows::SampleWindows(std::string who) : who_(std::move(who)) {
   if (!counters_) std::fprintf(stderr, "agnocast-bench: no window counters: %s\n", why.c_str());
 }
 
-void SampleWindows::before_send() {
-  if (!timed_) return;
+void SampleWindows::start() {
   if (counters_) before_ = counters_->read();
   cpu_ = sched_getcpu();
   start_ns_ = now_ns();
 }
 
-void SampleWindows::sent() {
-  if (timed_) send_ns_ = now_ns() - start_ns_;
-}
-
-void SampleWindows::after_ack(std::uint64_t seq) {
-  if (!timed_) return;
+void SampleWindows::record(std::uint64_t seq) {
   const std::int64_t acked_ns = now_ns() - start_ns_;
   const std::vector<std::int64_t> delta =
       counters_ ? counters_between(before_, counters_->read()) : std::vector<std::int64_t>{};

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.hpp"
+
 namespace agnocast::bench {
 
 class WindowCounters {
@@ -47,11 +49,21 @@ std::vector<std::int64_t> counters_between(const std::vector<std::int64_t>& befo
 class SampleWindows {
  public:
   explicit SampleWindows(std::string who);
-  void before_send();
-  void sent();
-  void after_ack(std::uint64_t seq);
+  // Inline tests, so that untimed runs (icount's) spend next to no
+  // instructions in the measured window.
+  void before_send() {
+    if (timed_) start();
+  }
+  void sent() {
+    if (timed_) send_ns_ = now_ns() - start_ns_;
+  }
+  void after_ack(std::uint64_t seq) {
+    if (timed_) record(seq);
+  }
 
  private:
+  void start();
+  void record(std::uint64_t seq);
   std::string who_;
   bool timed_ = false;
   std::optional<WindowCounters> counters_;

@@ -21,6 +21,7 @@
 #include "allocation_counter.hpp"
 #include "bench_support.hpp"
 #include "syscall_counter.hpp"
+#include "window_counters.hpp"
 
 namespace agnocast::bench {
 namespace {
@@ -128,6 +129,8 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
     auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{1});
     read_bytes(ready.read_fd, subscribers);
     SharedScratch scratch(scratch_bytes);
+    SampleWindows windows("agnocast size=" + std::to_string(size) +
+                          " scratch=" + std::to_string(scratch_bytes));
     for (std::size_t seq = 0; seq < total; ++seq) {
       auto message = pub->borrow_loaned_message();
       message->payload.resize(size);
@@ -135,9 +138,12 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
       fill_payload(scratch.bytes(), seq);
       message->seq = seq;
       delivered->store(0);
+      windows.before_send();
       message->t0_ns = now_ns();
       pub->publish(std::move(message));
+      windows.sent();
       read_bytes(ack.read_fd, 1);
+      windows.after_ack(seq);
       settle_between_messages();
     }
     return 0;

@@ -16,6 +16,8 @@
 #include <system_error>
 #include <vector>
 
+#include "window_counters.hpp"
+
 namespace agnocast::bench {
 namespace {
 
@@ -87,7 +89,8 @@ struct SocketFrame {
 
 }  // namespace
 
-std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait) {
+std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait,
+                                           std::size_t scratch_bytes) {
   const std::string ping_name = queue_name("ping"), pong_name = queue_name("pong");
   mqd_t ping = open_queue(ping_name);
   mqd_t pong = open_queue(pong_name);
@@ -108,12 +111,21 @@ std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait) {
   }
   std::vector<std::int64_t> one_way;
   one_way.reserve(count);
+  SharedScratch scratch(scratch_bytes);
+  SampleWindows windows(
+      std::string(wait == FloorWait::epoll ? "mqueue_epoll_floor" : "mqueue_floor") +
+      " size=1 scratch=" + std::to_string(scratch_bytes));
   char byte = 1;
   for (std::size_t i = 0; i < count; ++i) {
+    fill_payload(scratch.bytes(), i);
+    windows.before_send();
     std::int64_t t0 = now_ns();
-    if (mq_send(ping, &byte, 1, 0) != 0 || mq_receive(pong, &byte, 1, nullptr) != 1) {
+    const bool sent = mq_send(ping, &byte, 1, 0) == 0;
+    windows.sent();
+    if (!sent || mq_receive(pong, &byte, 1, nullptr) != 1) {
       throw std::system_error(errno, std::generic_category(), "mqueue ping-pong");
     }
+    windows.after_ack(i);
     one_way.push_back(arrivals[i] - t0);
     settle_between_messages();
   }
@@ -209,14 +221,19 @@ std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t cou
   close(fds[1]);
   results.close_write();
   std::vector<std::uint8_t> payload(size), scratch(scratch_bytes);
+  SampleWindows windows("unix_socket size=" + std::to_string(size) +
+                        " scratch=" + std::to_string(scratch_bytes));
   for (std::size_t seq = 0; seq < count; ++seq) {
     fill_payload(payload, seq);
     fill_payload(scratch, seq);
+    windows.before_send();
     SocketFrame frame{seq, now_ns(), size};
     write_all(fds[0], &frame, sizeof frame);
     write_all(fds[0], payload.data(), size);
+    windows.sent();
     char ack = 0;
     read_all(fds[0], &ack, 1);
+    windows.after_ack(seq);
     settle_between_messages();
   }
   close(fds[0]);

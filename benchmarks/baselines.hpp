@@ -15,7 +15,8 @@ enum class FloorWait { blocking, epoll };
 // One-way times (ns) of a 1-byte POSIX message queue ping-pong: send to
 // the receiver's return from mq_receive, the sender having just woken as a
 // publisher has.
-std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait);
+std::vector<std::int64_t> run_mqueue_floor(std::size_t count, FloorWait wait,
+                                           std::size_t scratch_bytes = 0);
 
 // Send of the first to the last receiver's return (ns): one process sends a
 // 1-byte message to each of `receivers` queues, each with its own receiver

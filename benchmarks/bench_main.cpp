@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,6 +23,7 @@
 #include <optional>
 #include <random>
 #include <regex>
+#include <sstream>
 
 #include "agnocast_roles.hpp"
 #include "baselines.hpp"
@@ -83,6 +85,29 @@ struct Cell {
   std::string label;
   std::function<std::vector<std::int64_t>(std::vector<std::int64_t>& extra)> run;
 };
+
+// What the senders recorded of one cell's samples (SampleWindows): one map
+// of name to value per sample, the measured ones last.
+std::vector<std::map<std::string, std::int64_t>> read_windows(const std::string& path) {
+  std::vector<std::map<std::string, std::int64_t>> windows;
+  std::ifstream file(path);
+  std::string line;
+  while (std::getline(file, line)) {
+    std::map<std::string, std::int64_t> values;
+    std::istringstream fields(line);
+    std::string field;
+    while (fields >> field) {
+      const auto equals = field.find('=');
+      if (equals == std::string::npos) continue;
+      try {
+        values[field.substr(0, equals)] = std::stoll(field.substr(equals + 1));
+      } catch (const std::exception&) {
+      }
+    }
+    windows.push_back(std::move(values));
+  }
+  return windows;
+}
 
 // Runs a cell in a child process of its own process group, so that a role
 // that hangs (a peer died while it waited) costs one cell of one round, not
@@ -332,6 +357,12 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   constexpr int cell_limit_s = 180;
   std::mt19937_64 shuffle(plan.seed);
   const std::string small = bench::format_size(64), page = bench::format_size(4 << 10);
+  struct SendCalls {
+    std::vector<double> send_us;
+    std::size_t delivered_first = 0;  // the receiver had it before the call returned
+  };
+  std::map<std::string, std::map<std::string, SendCalls>> send_calls;
+  const std::string windows_path = "/tmp/agnocast-bench-windows-" + std::to_string(getpid());
   for (std::size_t round = 0; round < plan.rounds; ++round) {
     std::vector<Cell> cells;
     const std::size_t n = plan.latency_samples;
@@ -401,8 +432,30 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
     std::cerr << "round " << round + 1 << " of " << plan.rounds << ": " << cells.size()
               << " series, " << (bench::now_ns() - started_ns) / 1'000'000'000 << " s so far\n";
     for (const Cell& cell : cells) {
+      // In the ordinary mode the 64 MiB-written series also time the
+      // sender's send call (one clock read after it returns), which the
+      // roles append to a file: whether the receiver had the message before
+      // it returned tells a stalled sender from a slow path.
+      const bool timed = !plan.icount && cell.who.ends_with("_constant_bytes");
+      if (timed) {
+        std::remove(windows_path.c_str());
+        setenv("AGNOCAST_BENCH_WINDOWS", "times", 1);
+        setenv("AGNOCAST_BENCH_WINDOWS_FILE", windows_path.c_str(), 1);
+      }
       std::vector<std::int64_t> measured, extra;
       if (!run_isolated(cell, cell_limit_s, measured, extra)) ++failed_cells;
+      if (timed) {
+        unsetenv("AGNOCAST_BENCH_WINDOWS");
+        unsetenv("AGNOCAST_BENCH_WINDOWS_FILE");
+        const auto windows = read_windows(windows_path);
+        SendCalls& calls = send_calls[cell.who][cell.label];
+        for (std::size_t i = 0; i < measured.size() && windows.size() >= measured.size(); ++i) {
+          const auto& window = windows[windows.size() - measured.size() + i];
+          if (!window.contains("send_ns")) continue;
+          calls.send_us.push_back(static_cast<double>(window.at("send_ns")) / 1000);
+          if (measured[i] < window.at("send_ns")) ++calls.delivered_first;
+        }
+      }
       samples.add(round, cell.who, cell.label, measured);
       for (std::int64_t rate : extra) background_rates.push_back(static_cast<double>(rate));
     }
@@ -447,6 +500,15 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
     report["latency"]["iceoryx_constant_bytes"] = nullptr;
   }
   if (want_python && !python) report["latency"]["python_subscriber_constant_bytes"] = nullptr;
+  std::remove(windows_path.c_str());
+  for (const auto& [who, labels] : send_calls) {
+    for (const auto& [label, calls] : labels) {
+      if (calls.send_us.empty()) continue;
+      report["send_call"][who][label] = {{"samples", calls.send_us.size()},
+                                         {"p50_us", bench::median(calls.send_us)},
+                                         {"delivered_before_it_returned", calls.delivered_first}};
+    }
+  }
   report["failed_cells"] = failed_cells;
   if (!plan.icount) {
     report["background"] = {
@@ -622,6 +684,103 @@ int repeat_check(std::size_t samples, double tolerance) {
   return difference <= tolerance ? 0 : 1;
 }
 
+// The 64 B series of agnocast, iceoryx, the mqueue floors and the Unix socket,
+// with and without 64 MiB written before each sample, in shuffled order over
+// `plan.rounds` rounds.  Per series: the one-way latency, how long the
+// sender's send call took (publish(), mq_send, write), how often the receiver
+// had the message before that call returned, and with `counters` the kernel's
+// counters over each sample (the reads cost time of their own, so the
+// latencies are then a little longer).
+int window_check(const Plan& plan, const std::string& iceoryx_role, bool counters) {
+  setenv("AGNOCAST_BENCH_WINDOWS", counters ? "counters" : "times", 1);
+  const std::string path = "/tmp/agnocast-bench-windows-" + std::to_string(getpid());
+  setenv("AGNOCAST_BENCH_WINDOWS_FILE", path.c_str(), 1);
+  auto iceoryx = bench::IceoryxRunner::start(iceoryx_role);
+  const std::size_t m = plan.constant_bytes_samples;
+  const std::size_t scratch = bench::constant_written_bytes - 64;
+  std::mt19937_64 shuffle(plan.seed);
+  struct Series {
+    std::vector<double> latency_us, send_us;
+    std::size_t before_return = 0;
+    std::map<std::string, std::vector<double>> counted;
+  };
+  std::map<std::string, Series> all;
+  for (std::size_t round = 0; round < plan.rounds; ++round) {
+    std::vector<Cell> cells;
+    for (std::size_t written : {std::size_t{0}, scratch}) {
+      const std::string label = written ? "64 MiB written" : "nothing written";
+      cells.push_back({"agnocast", label, [=](auto&) {
+                         return bench::run_agnocast_latency(64, m, 1, written).front();
+                       }});
+      if (iceoryx) {
+        cells.push_back(
+            {"iceoryx", label, [&, written](auto&) { return iceoryx->measure(64, m, written); }});
+      }
+      cells.push_back({"mqueue, receiver in mq_receive", label, [=](auto&) {
+                         return bench::run_mqueue_floor(m, bench::FloorWait::blocking, written);
+                       }});
+      cells.push_back({"mqueue, receiver in epoll_wait", label, [=](auto&) {
+                         return bench::run_mqueue_floor(m, bench::FloorWait::epoll, written);
+                       }});
+      cells.push_back({"Unix socket", label,
+                       [=](auto&) { return bench::run_unix_socket_copy(64, m, written); }});
+    }
+    std::shuffle(cells.begin(), cells.end(), shuffle);
+    std::cerr << "round " << round + 1 << " of " << plan.rounds << "\n";
+    for (const Cell& cell : cells) {
+      std::remove(path.c_str());
+      std::vector<std::int64_t> measured, extra;
+      if (!run_isolated(cell, 180, measured, extra)) continue;
+      const auto windows = read_windows(path);
+      if (windows.size() < measured.size()) continue;
+      Series& series = all[cell.who + ", " + cell.label];
+      for (std::size_t i = 0; i < measured.size(); ++i) {
+        const auto& window = windows[windows.size() - measured.size() + i];
+        const double send_us = static_cast<double>(window.at("send_ns")) / 1000;
+        const double latency_us = static_cast<double>(measured[i]) / 1000;
+        series.latency_us.push_back(latency_us);
+        series.send_us.push_back(send_us);
+        std::cerr << "sample " << cell.who << ", " << cell.label << ": latency_ns=" << measured[i];
+        for (const auto& [name, value] : window) std::cerr << " " << name << "=" << value;
+        std::cerr << "\n";
+        if (latency_us < send_us) ++series.before_return;
+        for (const auto& [name, value] : window) {
+          if (name != "seq" && name != "cpu" && name != "send_ns" && name != "acked_ns" &&
+              name != "size" && name != "scratch") {
+            series.counted[name].push_back(static_cast<double>(value));
+          }
+        }
+      }
+    }
+  }
+  std::remove(path.c_str());
+  std::printf(
+      "| 64 B, one way | samples | latency p50, us | send call p50, us | delivered before the "
+      "send call returned |\n|---|---|---|---|---|\n");
+  for (const auto& [name, series] : all) {
+    std::printf("| %s | %zu | %.0f | %.0f | %zu of %zu |\n", name.c_str(), series.latency_us.size(),
+                bench::median(series.latency_us), bench::median(series.send_us),
+                series.before_return, series.latency_us.size());
+  }
+  if (!counters || all.empty()) return 0;
+  std::printf(
+      "\nKernel counters over a sample (every CPU, from before the send to the ack), "
+      "median of samples:\n\n| series |");
+  const auto& names = all.begin()->second.counted;
+  for (const auto& [name, values] : names) std::printf(" %s |", name.c_str());
+  std::printf("\n|---|");
+  for (std::size_t i = 0; i < names.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  for (const auto& [name, series] : all) {
+    std::printf("| %s |", name.c_str());
+    for (const auto& [counter, values] : series.counted) {
+      std::printf(" %.1f |", bench::median(values));
+    }
+    std::printf("\n");
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -663,6 +822,13 @@ int main(int argc, char** argv) {
   app.add_flag("--repeat-check", repeat,
                "measure agnocast's 64 B p50 twice; fail if they differ by more than 1 % (a check "
                "of icount mode's repeatability)");
+  bool windows = false, window_counters = false;
+  app.add_flag("--window-counters", window_counters,
+               "with --window-check: the kernel's counters too, which cost time themselves");
+  app.add_flag("--window-check", windows,
+               "measure only the 64 B series of agnocast, iceoryx, the mqueue floors and the Unix "
+               "socket, with and without 64 MiB written first: latency, the sender's send call, "
+               "and whether the receiver had the message before that call returned");
   std::string render;
   app.add_option("--render", render,
                  "measure nothing: print a saved --json report as Markdown tables");
@@ -703,6 +869,7 @@ int main(int argc, char** argv) {
     std::cerr << "agnocast-bench: could not start again without address randomization\n";
   }
   if (repeat) return repeat_check(plan.latency_samples, 0.01);
+  if (windows) return window_check(plan, iceoryx_role, window_counters);
   if (smoke) plan.make_smoke();
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
   try {

@@ -17,6 +17,7 @@
 #include "iceoryx_posh/popo/untyped_subscriber.hpp"
 #include "iceoryx_posh/popo/wait_set.hpp"
 #include "iceoryx_posh/runtime/posh_runtime.hpp"
+#include "window_counters.hpp"
 
 namespace bench = agnocast::bench;
 
@@ -60,6 +61,8 @@ int run_publisher(const Options& options) {
   if (!bench::read_all(options.ready_fd, &byte, 1)) return 1;
   while (!publisher.hasSubscribers()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   bench::SharedScratch scratch(options.scratch_bytes);
+  bench::SampleWindows windows("iceoryx size=" + std::to_string(options.size) +
+                               " scratch=" + std::to_string(options.scratch_bytes));
   const std::size_t total =
       options.steady ? bench::steady_warmup_messages + options.count : options.count;
   std::int64_t next = bench::now_ns(), cpu0 = 0;
@@ -79,13 +82,16 @@ int run_publisher(const Options& options) {
     bench::fill_payload(scratch.bytes(), seq);
     auto* header = reinterpret_cast<Header*>(chunk);
     header->seq = seq;
+    windows.before_send();
     header->t0_ns = bench::now_ns();
     publisher.publish(chunk);
+    windows.sent();
     if (options.steady) {
       if (seq + 1 == bench::steady_warmup_messages) cpu0 = bench::cpu_time_ns();
       continue;
     }
     if (!bench::read_all(options.ack_fd, &byte, 1)) return 1;
+    windows.after_ack(seq);
     bench::settle_between_messages();
   }
   if (options.steady) report_cpu(options.results_fd, 0, bench::cpu_time_ns() - cpu0);

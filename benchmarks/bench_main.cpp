@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
+#include <set>
 
 #include "agnocast_roles.hpp"
 #include "baselines.hpp"
@@ -51,6 +52,10 @@ struct Plan {
   // on one vCPU, so every p50 repeats to the nanosecond and a few rounds
   // suffice; series that need parallel cores are left to the ordinary mode.
   bool icount = false;
+  // --only: the series (and `cost_breakdown`) to measure, nothing else; empty:
+  // everything.  For checking a change quickly, not for the report.
+  std::set<std::string> only;
+  bool wants(const std::string& what) const { return only.empty() || only.contains(what); }
   // What the VM cannot see of where it runs, passed in by scripts/bench.
   std::string host_cpu, qemu_version, qemu_flags;
 
@@ -354,6 +359,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                          return bench::run_mqueue_fanout(subscribers, plan.fanout_samples);
                        }});
     }
+    std::erase_if(cells, [&](const Cell& cell) { return !plan.wants(cell.who); });
     std::shuffle(cells.begin(), cells.end(), shuffle);
     std::cerr << "round " << round + 1 << " of " << plan.rounds << ": " << cells.size()
               << " series, " << (bench::now_ns() - started_ns) / 1'000'000'000 << " s so far\n";
@@ -498,8 +504,11 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                   : json{{"agnocast", bench::median(agnocast_slopes)},
                          {"mqueue", bench::median(mqueue_slopes)}};
 
-  std::cerr << "the cost of one message, call by call...\n";
-  json breakdown = cost_breakdown(breakdown_program, plan.smoke);
+  json breakdown;
+  if (plan.wants("cost_breakdown")) {
+    std::cerr << "the cost of one message, call by call...\n";
+    breakdown = cost_breakdown(breakdown_program, plan.smoke);
+  }
   if (breakdown.is_object()) {
     // The bare hop, measured above in the same boot: mq_send to the
     // receiver's return from mq_receive, receiver asleep in epoll_wait
@@ -510,6 +519,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
         samples.round_p50(all_rounds, "mqueue_floor", "1 B") * 1000;
   }
   report["cost_breakdown"] = breakdown;
+  if (!plan.only.empty()) return report;
 
   std::cerr << "system calls and CPU time at 1 kHz...\n";
   // CPU time without counters, as iceoryx's and the floor's; then the counts.
@@ -591,6 +601,9 @@ int main(int argc, char** argv) {
   app.add_option("--iceoryx-role", iceoryx_role, "the iceoryx role program");
   app.add_option("--breakdown-program", breakdown_program, "the cost breakdown program");
   app.add_option("--cli", cli, "the agnocast-cli program, whose bag record is measured");
+  app.add_option("--only", plan.only,
+                 "measure only these series (and cost_breakdown), comma-separated; prints JSON")
+      ->delimiter(',');
   app.add_flag("--icount", plan.icount,
                "the VM runs in QEMU's instruction-counting mode: fewer rounds, single-valued "
                "ratios, no series that needs parallel cores");
@@ -645,7 +658,7 @@ int main(int argc, char** argv) {
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
   try {
     json report = run(plan, iceoryx_role, breakdown_program, cli);
-    if (json_output) {
+    if (json_output || !plan.only.empty()) {
       std::cout << report.dump() << "\n";
     } else {
       bench::print_markdown(report);

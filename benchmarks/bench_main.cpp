@@ -56,9 +56,10 @@ struct Plan {
   bool icount = false;
   // What the VM cannot see of where it runs, passed in by scripts/bench.
   std::string host_cpu, qemu_version, qemu_flags;
-  // Only the series whose names match (--series); empty: every series, and
-  // the rest of the report (cost breakdown, system calls, CPU, throughput,
-  // recording), which a selection leaves out.
+  // Only the series whose names match (--series), and the cost breakdown
+  // when "cost_breakdown" matches; empty: every series, and the rest of the
+  // report (system calls, CPU, throughput, recording), which a selection
+  // leaves out.
   std::string series;
   bool selected(const std::string& who) const {
     return series.empty() || std::regex_search(who, std::regex(series));
@@ -612,10 +613,11 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                   : json{{"agnocast", bench::median(agnocast_slopes)},
                          {"mqueue", bench::median(mqueue_slopes)}};
 
-  if (!plan.series.empty()) return report;  // a selection: its series only
-
-  std::cerr << "the cost of one message, call by call...\n";
-  json breakdown = cost_breakdown(breakdown_program, plan.smoke);
+  json breakdown;
+  if (plan.selected("cost_breakdown")) {
+    std::cerr << "the cost of one message, call by call...\n";
+    breakdown = cost_breakdown(breakdown_program, plan.smoke);
+  }
   if (breakdown.is_object()) {
     // The bare hop, measured above in the same boot: mq_send to the
     // receiver's return from mq_receive, receiver asleep in epoll_wait
@@ -626,6 +628,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
         samples.round_p50(all_rounds, "mqueue_floor", "1 B") * 1000;
   }
   report["cost_breakdown"] = breakdown;
+  if (!plan.series.empty()) return report;  // a selection: its series only
 
   std::cerr << "system calls and CPU time at 1 kHz...\n";
   // CPU time without counters, as iceoryx's and the floor's; then the counts.

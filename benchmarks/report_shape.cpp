@@ -1,5 +1,6 @@
 #include "report_shape.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -485,6 +486,61 @@ double calls_per_message(const json& report, const char* run, const char* side) 
   return value.is_number() ? value.get<double>() : std::numeric_limits<double>::quiet_NaN();
 }
 
+// p50 of the breakdown's call `name` on `side`, NaN when it has none.
+double call_ns(const json& breakdown, const char* side, const std::string& name) {
+  const json& calls = at_path(breakdown, {side, "calls"});
+  if (calls.is_array()) {
+    for (const json& call : calls) {
+      if (call.value("name", std::string()) == name && call["ns"].is_number()) {
+        return call["ns"].get<double>();
+      }
+    }
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+double number_or_nan(const json& value) {
+  return value.is_number() ? value.get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+
+// Why the one-way latency targets stand where they do, from the cost
+// breakdown: what of the window is the kernel's, what is left to the library.
+void print_why_latency_stands(const json& icount) {
+  const json& breakdown = icount["cost_breakdown"];
+  const double publish = call_ns(breakdown, "publisher", "ioctl PUBLISH");
+  const double receive = call_ns(breakdown, "subscriber", "ioctl RECEIVE");
+  const double hop = number_or_nan(at_path(breakdown, {"reference", "mqueue_hop_epoll_ns"}));
+  const double mq_receive = number_or_nan(at_path(breakdown, {"reference", "mq_receive_ns"}));
+  const double floor =
+      number_or_nan(at_path(icount, {"latency", "mqueue_epoll_floor", "1 B", "p50_us"}));
+  const double ours = number_or_nan(at_path(icount, {"latency", "agnocast", "64 B", "p50_us"}));
+  const double iceoryx = number_or_nan(at_path(icount, {"latency", "iceoryx", "64 B", "p50_us"}));
+  if (std::isnan(publish) || std::isnan(receive) || std::isnan(hop) || std::isnan(mq_receive) ||
+      std::isnan(ours)) {
+    return;
+  }
+  // The floor's hop less its mq_receive: agnocast takes its notification after the callback.
+  const double kernel_path = hop - mq_receive + publish + receive;
+  const double budget = std::min(
+      {12000.0, floor * 1000 * 1.5, std::isnan(iceoryx) ? 12000.0 : iceoryx * 1000 * 0.85});
+  const double rest = ours * 1000 - kernel_path;
+  std::printf(
+      "\nWhy the one-way targets stand where they do: agnocast's window holds the mqueue hop "
+      "it shares with the floor (`mq_send` to the return from `epoll_wait`, %.0f instructions: "
+      "the floor's %.0f less its `mq_receive`, which agnocast's subscriber makes after the "
+      "callback) and its own two ioctls (PUBLISH %.0f, RECEIVE %.0f): %.0f before any of the "
+      "library's user space runs.  The 64 B p50 is %.0f; the rest of the window, %.0f, is "
+      "mostly the library's own code (the publish call on one side; the executor's wake-up, "
+      "the receive loop and the callback's dispatch on the other).  The strictest of the three "
+      "targets (12,000; 1.5 × the floor; 0.85 × iceoryx) is %.0f, which leaves that rest "
+      "%.0f: %s.  The fan-out slope stays near 2 for the same reason: each further subscriber "
+      "is woken by an `mq_send` of its own, as in the mqueue series, and then also makes its "
+      "RECEIVE, takes its notification and runs the library's wake-up, all on the one vCPU "
+      "before the last subscriber's callback.\n",
+      hop - mq_receive, hop, publish, receive, kernel_path, ours * 1000, rest, budget,
+      budget - kernel_path, rest <= budget - kernel_path ? "it fits" : "less than it takes now");
+}
+
 }  // namespace
 
 void print_readme(const json& combined) {
@@ -674,6 +730,7 @@ depend on it.
       "publisher 1 + N (N = 4 subscribers): %.2f: %s\n",
       sub_10, sub_1, sub_10 <= 3 && sub_1 <= 3 ? "**met**" : "**not met**", pub_4,
       pub_4 <= 5 ? "**met**" : "**not met**");
+  print_why_latency_stands(icount);
   std::printf("\nIn ordinary mode (whole 95 %% interval under the target):\n\n");
   std::printf("- `size_flatness` ≤ 1.05: %s\n",
               standing(at_path(ordinary, {"ratios", "size_flatness"}), 1.05, "%.2f",

@@ -1,10 +1,12 @@
 // agnocast-cli against a live system in the VM: a talker, a listener, a
-// stopped listener (its pending wake-ups and unreceived entries grow) and a
-// hand-made stale queue /ghost@7. Every command's table and JSON are checked,
-// the exit codes 0/1/2, and, last, doctor failing once the module is removed.
+// stopped listener (wake-once: one wake-up pending, its unreceived entries
+// growing to its depth; then resumed, missing none of them) and a hand-made
+// stale queue /ghost@7. Every command's table and JSON are checked, the exit
+// codes 0/1/2, and, last, doctor failing once the module is removed.
 #include <fcntl.h>
 #include <grp.h>
 #include <gtest/gtest.h>
+#include <mqueue.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -98,9 +100,26 @@ void expect_ends_under_header(const std::string& table, const std::string& heade
       << row;
 }
 
+// The notifications waiting in `queue` (its mq_curmsgs), read here, not
+// through agnocast-cli; -1 if it cannot be opened.
+long queued_notifications(const std::string& queue) {
+  const mqd_t q = ::mq_open(queue.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (q == static_cast<mqd_t>(-1)) return -1;
+  mq_attr attributes{};
+  const int r = ::mq_getattr(q, &attributes);
+  ::mq_close(q);
+  return r == 0 ? attributes.mq_curmsgs : -1;
+}
+
 // A nested name, so queue names show the mangling ('/' -> '_').
 const std::string topic = "/cli_live/chatter";
 const std::string queue_prefix = "/cli_live_chatter@";
+
+// The subscriber of `pid` in `topic info`, or null.
+json subscriber_of(pid_t pid) {
+  const Outcome r = cli("topic info " + topic + " --json");
+  return r.code == 0 ? find_by(r.value()["subscribers"], "pid", pid) : json();
+}
 
 class CliLive : public ::testing::Test {
  protected:
@@ -121,6 +140,18 @@ class CliLive : public ::testing::Test {
         },
         patience))
         << "the listeners never subscribed";
+    // Stopped once it has taken the notification it sends itself on
+    // subscribing (twice empty, 100 ms apart): from then on only the talker
+    // wakes it.
+    ASSERT_TRUE(eventually(
+        [] {
+          const json s = subscriber_of(stopped);
+          if (s.is_null() || queued_notifications(s["queue"].get<std::string>()) != 0) return false;
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          return queued_notifications(s["queue"].get<std::string>()) == 0;
+        },
+        patience))
+        << "the listener to stop never took its own notification";
     ASSERT_EQ(::kill(stopped, SIGSTOP), 0);
     talker = spawn({"agnocast-talker", "--topic", topic, "--node", "talker", "--depth", "10",
                     "--rate", "50", "--size", "1000"},
@@ -129,13 +160,12 @@ class CliLive : public ::testing::Test {
     const int ghost = ::open("/dev/mqueue/ghost@7", O_RDWR | O_CREAT, 0600);
     ASSERT_GE(ghost, 0) << "cannot create /dev/mqueue/ghost@7";
     ::close(ghost);
-    // Let the stopped listener's queue fill and its entries pile up.
+    // Let the stopped listener's entries pile up beyond its depth.  It is
+    // wake-once: one notification waits for it however many entries do.
     ASSERT_TRUE(eventually(
         [] {
-          const Outcome r = cli("topic info " + topic + " --json");
-          if (r.code != 0) return false;
-          const json s = find_by(r.value()["subscribers"], "pid", stopped);
-          return !s.is_null() && s["pending"] == 10 && s["unreceived"] == 10 && s["dropped"] > 0;
+          const json s = subscriber_of(stopped);
+          return !s.is_null() && s["unreceived"] == 10 && s["dropped"] > 0;
         },
         patience))
         << slurp("cli-0.out");
@@ -188,7 +218,9 @@ TEST_F(CliLive, TopicInfo) {
   EXPECT_EQ(live["queue"], queue_prefix + live["id"].dump());
   EXPECT_EQ(frozen["node"], "stopped");
   EXPECT_EQ(frozen["queue"], queue_prefix + frozen["id"].dump());
-  EXPECT_EQ(frozen["pending"], 10);  // a full queue: the talker never blocks on it
+  // pending is the queue's mq_curmsgs: one wake-up for all ten entries.
+  EXPECT_EQ(frozen["pending"], 1);
+  EXPECT_EQ(frozen["pending"], queued_notifications(frozen["queue"].get<std::string>()));
   EXPECT_EQ(frozen["unreceived"], 10);
   EXPECT_GT(frozen["dropped"].get<int>(), 0);
   EXPECT_EQ(live["uid"], 0);
@@ -212,7 +244,7 @@ TEST_F(CliLive, TopicInfo) {
   ASSERT_EQ(frozen_row.size(), 12u) << table.out;
   EXPECT_EQ(frozen_row[1], std::to_string(stopped));
   EXPECT_EQ(frozen_row[6], frozen["queue"]);
-  EXPECT_EQ(frozen_row[7], "10");
+  EXPECT_EQ(frozen_row[7], "1");
   EXPECT_EQ(frozen_row[8], "10");
   EXPECT_NE(table.out.find("PENDING  UNRECEIVED  HELD  RECEIVED  DROPPED"), std::string::npos);
 }
@@ -280,7 +312,7 @@ TEST_F(CliLive, QueueListShowsOwnersDepthsAndTheStaleGhost) {
                                 {"topic", topic},
                                 {"subscriber_id", frozen["id"]},
                                 {"pid", stopped},
-                                {"pending", 10},
+                                {"pending", 1},
                                 {"capacity", 10},
                                 {"stale", false}}));
   const json live_queue = find_by(queues, "pid", listener);
@@ -302,7 +334,7 @@ TEST_F(CliLive, QueueListShowsOwnersDepthsAndTheStaleGhost) {
             (std::vector<std::string>{"/ghost@7", "-", "7", "-", "0", "10", "yes"}));
   EXPECT_EQ(row_starting(table.out, frozen["queue"]),
             (std::vector<std::string>{frozen["queue"], topic, frozen["id"].dump(),
-                                      std::to_string(stopped), "10", "10", "no"}));
+                                      std::to_string(stopped), "1", "10", "no"}));
   expect_ends_under_header(table.out, "CAPACITY", line_containing(table.out, "/ghost@7"));
 }
 
@@ -424,6 +456,32 @@ TEST_F(CliLive, ExitCodes) {
   const Outcome json_missing = cli("topic info /nope --json");
   EXPECT_EQ(json_missing.code, 1);
   EXPECT_EQ(json_missing.value()["exit_code"], 1);
+}
+
+// After every test that looks at the stopped listener: resumed, its one
+// notification wakes it and it receives every entry the kernel kept for it.
+TEST_F(CliLive, TheStoppedListenerResumesAndReceivesEveryKeptEntry) {
+  ASSERT_EQ(::kill(talker, SIGSTOP), 0);  // nothing new meanwhile
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const json before = subscriber_of(stopped);
+  ASSERT_FALSE(before.is_null());
+  EXPECT_EQ(before["received"], 0);
+  EXPECT_EQ(before["unreceived"], 10);
+  EXPECT_EQ(queued_notifications(before["queue"].get<std::string>()), 1);
+
+  ASSERT_EQ(::kill(stopped, SIGCONT), 0);
+  json after;
+  EXPECT_TRUE(eventually(
+      [&] {
+        after = subscriber_of(stopped);
+        return !after.is_null() && after["received"] == 10 && after["unreceived"] == 0 &&
+               queued_notifications(after["queue"].get<std::string>()) == 0;
+      },
+      patience))
+      << after.dump();
+  EXPECT_EQ(after["pending"], 0);
+  EXPECT_EQ(after["dropped"], before["dropped"]) << "nothing dropped once it resumed";
+  ASSERT_EQ(::kill(talker, SIGCONT), 0);
 }
 
 // Last: it removes the module (and puts it back).

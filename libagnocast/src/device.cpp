@@ -131,7 +131,8 @@ agnocast_add_endpoint to_uapi(const EndpointRequest& request) {
   argument.depth = request.depth;
   argument.flags = (request.transient_local ? AGNOCAST_TRANSIENT_LOCAL : 0U) |
                    (request.polling ? AGNOCAST_POLLING : 0U) |
-                   (request.ignore_local ? AGNOCAST_IGNORE_LOCAL : 0U);
+                   (request.ignore_local ? AGNOCAST_IGNORE_LOCAL : 0U) |
+                   (request.wake_once ? AGNOCAST_WAKE_ONCE : 0U);
   return argument;
 }
 

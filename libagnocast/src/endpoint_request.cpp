@@ -27,6 +27,7 @@ EndpointRequest make_endpoint_request(std::string_view node, std::string_view to
   request.depth = static_cast<std::uint32_t>(qos.depth());
   request.transient_local = qos.is_transient_local();
   request.polling = kind == EndpointKind::polling_subscriber;
+  request.wake_once = kind == EndpointKind::callback_subscriber;
   request.type_name = std::string(type.name);
   request.type_hash = type.hash;
   request.schema = type.schema;

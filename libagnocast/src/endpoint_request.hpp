@@ -21,6 +21,9 @@ struct EndpointRequest {
   bool transient_local = false;
   bool polling = false;
   bool ignore_local = false;  // subscribers: skip messages of this process (kernel-filtered)
+  // Callback subscribers: one notification between two receives, however many
+  // entries arrive meanwhile (the wake-up receives until nothing remains).
+  bool wake_once = false;
   // The message type: the topic's must be the same (TypeMismatch otherwise).
   std::string type_name;
   std::uint64_t type_hash = 0;

@@ -75,6 +75,7 @@ EndpointId FakeKernel::add_subscriber(const EndpointRequest& request) {
   subscriber.transient_local = request.transient_local;
   subscriber.polling = request.polling;
   subscriber.ignore_local = request.ignore_local;
+  subscriber.wake_once = request.wake_once;
   if (request.transient_local) {
     std::vector<std::uint64_t> kept;
     for (const auto& [publisher_id, publisher] : topic.publishers) {
@@ -161,7 +162,9 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
       subscriber.unreceived.pop_front();
       drop_unreceived(subscriber, oldest);
     }
-    if (!subscriber.polling) wake_ids[result.wake_count++] = id;
+    if (subscriber.polling || (subscriber.wake_once && subscriber.notified)) continue;
+    subscriber.notified = true;
+    wake_ids[result.wake_count++] = id;
   }
   publisher.window.push_back(entry_id);
   if (publisher.window.size() > publisher.depth) {
@@ -223,6 +226,7 @@ ReceiveResult FakeKernel::receive(EndpointId subscriber_id, std::span<ReceivedEn
   Subscriber& subscriber = subscriber_of(subscriber_id);
   if (subscriber.polling) fail("RECEIVE", EINVAL);
   release_held("RECEIVE", subscriber, release_ids);
+  subscriber.notified = false;
   ReceiveResult result;
   const std::size_t capacity = std::min(entries.size(), receive_entries_max);
   while (result.entry_count < capacity && !subscriber.unreceived.empty()) {

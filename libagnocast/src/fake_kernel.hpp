@@ -84,6 +84,8 @@ class FakeKernel final : public Kernel {
     bool transient_local = false;
     bool polling = false;
     bool ignore_local = false;
+    bool wake_once = false;
+    bool notified = false;  // wake_once: listed in a wake set since its last receive
     std::deque<std::uint64_t> unreceived;
     std::multiset<std::uint64_t> held;
     std::uint64_t received = 0;

@@ -27,7 +27,9 @@ MessageHeader* header_of(void* message) {
 void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void*)) {
   align = std::max(align, Tlsf::alignment);
   const std::size_t offset = (header_room + align - 1) & ~(align - 1);  // keeps message aligned
-  void* block = Runtime::get().allocate(offset + size, align);
+  Runtime& runtime = Runtime::get();
+  runtime.free_deferred();  // what the last publish reclaimed
+  void* block = runtime.allocate(offset + size, align);
   void* message = static_cast<char*>(block) + offset;
   const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
   *header_of(message) =

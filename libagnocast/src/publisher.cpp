@@ -111,7 +111,8 @@ void PublisherCore::publish(void* message, std::size_t bytes) {
     }
     for (std::uint32_t i = 0; i < result.wake_count; ++i) state.senders.notify(state.wake_ids[i]);
   }
-  state.runtime.free_reclaimed(std::span(reclaimed.data(), result.reclaim_count));
+  // Freed at the next borrow: the subscribers run first.
+  state.runtime.defer_free(std::span(reclaimed.data(), result.reclaim_count));
   if (result.reclaim_pending > 0) state.runtime.reclaim_all();
 }
 

@@ -5,11 +5,13 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <iterator>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "agnocast/allocator.hpp"
@@ -196,7 +198,35 @@ void Runtime::free_reclaimed(std::span<const std::uint64_t> addresses) noexcept 
   }
 }
 
+void Runtime::defer_free(std::span<const std::uint64_t> addresses) noexcept {
+  if (addresses.empty()) return;
+  {
+    std::lock_guard lock(deferred_mutex_);
+    if (deferred_count_ + addresses.size() <= deferred_.size()) {
+      std::copy(addresses.begin(), addresses.end(), deferred_.begin() + deferred_count_);
+      deferred_count_ += addresses.size();
+      deferred_waiting_.store(true, std::memory_order_release);
+      return;
+    }
+  }
+  free_reclaimed(addresses);
+}
+
+void Runtime::free_deferred() noexcept {
+  if (!deferred_waiting_.load(std::memory_order_acquire)) return;
+  std::array<std::uint64_t, deferred_max> batch;
+  std::size_t count;
+  {
+    std::lock_guard lock(deferred_mutex_);
+    count = std::exchange(deferred_count_, 0);
+    std::copy_n(deferred_.begin(), count, batch.begin());
+    deferred_waiting_.store(false, std::memory_order_relaxed);
+  }
+  free_reclaimed(std::span(batch.data(), count));
+}
+
 void Runtime::reclaim_all() {
+  free_deferred();
   std::vector<std::uint64_t> addresses(256);
   for (;;) {
     const ReclaimResult result = kernel_->reclaim(addresses);

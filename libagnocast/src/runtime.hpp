@@ -5,6 +5,8 @@
 
 #include <sys/types.h>
 
+#include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -42,7 +44,15 @@ class Runtime {
 
   // Destroys and frees messages the kernel reported as no longer referenced.
   void free_reclaimed(std::span<const std::uint64_t> addresses) noexcept;
-  // Asks the kernel for every reclaimable message of this process and frees it.
+  // Keeps reclaimed messages to free at the next borrow (free_deferred()), so
+  // that a publish returns as soon as its subscribers are woken; frees them now
+  // when a batch already waits.
+  void defer_free(std::span<const std::uint64_t> addresses) noexcept;
+  // Frees what defer_free() kept: on every borrow, before reclaiming, and
+  // before the pool is found exhausted.
+  void free_deferred() noexcept;
+  // Asks the kernel for every reclaimable message of this process and frees
+  // it, with what waits in defer_free().
   void reclaim_all();
 
   // Maps a publisher's pool read-only at its address and closes grant.fd.
@@ -65,6 +75,13 @@ class Runtime {
 
   mutable std::mutex pool_mutex_;
   Tlsf pool_;
+
+  // One publish's reclaimed messages, freed at the next borrow.
+  static constexpr std::size_t deferred_max = 64;
+  std::mutex deferred_mutex_;
+  std::array<std::uint64_t, deferred_max> deferred_;
+  std::size_t deferred_count_ = 0;
+  std::atomic<bool> deferred_waiting_{false};
 
   std::mutex mapped_mutex_;
   std::map<std::uint64_t, std::uint64_t> mapped_pools_;  // address -> size

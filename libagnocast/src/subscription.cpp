@@ -72,16 +72,17 @@ class SubscriberEndpoint : public EntryOwner {
   void release_entry(std::uint64_t entry_id) noexcept override {
     if (!still_ours()) return;
     std::lock_guard lock(release_mutex_);
-    pending_releases_[pending_count_++] = entry_id;
-    if (handling_wakeup_ && pending_count_ < release_batch) return;
-    release_pending();
+    add_release(entry_id);
   }
 
   // Called by the thread receiving, under the subscription's receive mutex:
-  // from now until end_wakeup(), releases wait for the next receive or the end.
-  void begin_wakeup() {
+  // from now until end_wakeup(), releases wait for the next receive or the
+  // end.  Moves what waits for this wake-up's first receive into batch (as
+  // take_releases()); returns their number.
+  std::size_t begin_wakeup(ReleaseBatch& batch) {
     std::lock_guard lock(release_mutex_);
     handling_wakeup_ = true;
+    return take_pending(batch);
   }
 
   // What still waits rides on the next receive once the timer is armed
@@ -145,10 +146,7 @@ class SubscriberEndpoint : public EntryOwner {
   // Moves the releases waiting for the next receive into batch; returns their number.
   std::size_t take_releases(ReleaseBatch& batch) {
     std::lock_guard lock(release_mutex_);
-    deadline_.store(no_deadline, std::memory_order_relaxed);
-    const std::size_t count = std::exchange(pending_count_, 0);
-    std::copy_n(pending_releases_.begin(), count, batch.begin());
-    return count;
+    return take_pending(batch);
   }
 
   // A failed receive released nothing: the ids wait for the next one, or
@@ -192,6 +190,21 @@ class SubscriberEndpoint : public EntryOwner {
  private:
   // False in a fork child: the endpoint and its references are the parent's.
   bool still_ours() const { return Runtime::current() == &runtime_; }
+
+  // With release_mutex_ held.
+  void add_release(std::uint64_t entry_id) noexcept {
+    pending_releases_[pending_count_++] = entry_id;
+    if (handling_wakeup_ && pending_count_ < release_batch) return;
+    release_pending();
+  }
+
+  // With release_mutex_ held.
+  std::size_t take_pending(ReleaseBatch& batch) noexcept {
+    deadline_.store(no_deadline, std::memory_order_relaxed);
+    const std::size_t count = std::exchange(pending_count_, 0);
+    std::copy_n(pending_releases_.begin(), count, batch.begin());
+    return count;
+  }
 
   // With release_mutex_ held. False when there is no timer to wait for.
   bool arm_deferred_release() noexcept {
@@ -372,15 +385,15 @@ std::size_t SubscriptionBase::handle_wakeup() {
   if (!drain_after) state.queue->take_one();
   SubscriberEndpoint::ReleaseBatch releases;
   SubscriberEndpoint& endpoint = *state.endpoint;
-  endpoint.begin_wakeup();
+  std::size_t release_count = endpoint.begin_wakeup(releases);
   struct EndWakeup {
     SubscriberEndpoint& endpoint;
-    const int exceptions = std::uncaught_exceptions();
-    ~EndWakeup() { endpoint.end_wakeup(std::uncaught_exceptions() == exceptions); }
+    bool completed = false;  // no callback threw
+    ~EndWakeup() { endpoint.end_wakeup(completed); }
   } end_wakeup{endpoint};
-  for (;;) {
-    const std::span<const std::uint64_t> released(releases.data(),
-                                                  state.endpoint->take_releases(releases));
+  for (bool first = true;; first = false) {
+    if (!first) release_count = endpoint.take_releases(releases);
+    const std::span<const std::uint64_t> released(releases.data(), release_count);
     ReceiveResult result;
     try {
       result = runtime.kernel().receive(state.endpoint->id(), entries, pools, released);
@@ -407,6 +420,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
     }
     if (result.remaining == 0) break;
   }
+  end_wakeup.completed = true;
   if (drain_after) state.queue->take_one();
   return delivered;
 }

@@ -98,6 +98,29 @@ long queued(int queue_fd) {
   return attributes.mq_curmsgs;
 }
 
+// Publishers wake a subscriber once between two of its receives: the
+// wake-up receives until nothing remains, so one notification is enough.
+TEST_F(SubscriptionTest, PublishersNotifyOncePerWakeUpHoweverManyMessagesWait) {
+  Node node{"wake_once"};
+  const std::string name = topic("wake_once");
+  int count = 0;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>&) { ++count; });
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  subscription->handle_wakeup();  // the subscription's own first notification
+  ASSERT_EQ(queued(subscription->queue_fd()), 0);
+
+  for (std::uint64_t seq = 0; seq < 5; ++seq) publish(*publisher, seq);
+  EXPECT_EQ(queued(subscription->queue_fd()), 1) << "one notification for five messages";
+  EXPECT_EQ(subscription->handle_wakeup(), 5U);
+  EXPECT_EQ(count, 5);
+  EXPECT_EQ(queued(subscription->queue_fd()), 0);
+
+  publish(*publisher, 5);  // after the receive: wakes it again
+  EXPECT_EQ(queued(subscription->queue_fd()), 1);
+  EXPECT_EQ(subscription->handle_wakeup(), 1U);
+}
+
 // Waits until the deferred release's timer expires, then runs it as the
 // executor would.
 bool run_deferred_release(SubscriptionBase& subscription) {

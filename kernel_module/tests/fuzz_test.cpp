@@ -307,6 +307,10 @@ struct Process {
   // exclusively; the commands whose topic is looked up take it shared, so the
   // handle's topic is the one the kernel acted on.  Taken after pool_lock.
   std::shared_mutex ep_lock;
+  // Held by a RECEIVE or TAKE until the pools it was handed are mapped, as
+  // the library does: the kernel hands a pool to the process once, and
+  // another thread may receive entries in it before it is mapped.
+  std::mutex grant_lock;
   std::mutex mu;  // guards what follows
   std::vector<uint64_t> free_slots;
   std::map<uint64_t, uint64_t> views;  // address -> size of mapped pools, ours included
@@ -632,6 +636,7 @@ struct Worker {
     arg.release_ids = chance(95) ? uptr(release_ids) : uptr(bad_pointer());
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
     std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    std::unique_lock<std::mutex> grants(proc->grant_lock);
     if (call(AGNOCAST_IOC_RECEIVE, &arg, e.handle, e.id)) return;
     if (arg.release_count) count(kReceiveReleases, 0);
     if (arg.entry_count) count(kReceiveEntries, 0);
@@ -645,6 +650,7 @@ struct Worker {
              arg.entry_count ? got[0].entry_id : 0, got_pools[i].addr);
     }
     map_pools(got_pools, arg.pool_count, false);
+    grants.unlock();
     int topic = proc->topic_for(e.handle);
     for (uint32_t i = 0; i < arg.entry_count; i++) {
       entries.push_back(got[i].entry_id);
@@ -666,10 +672,12 @@ struct Worker {
     if (!wellformed && chance(3)) arg.flags = 1;
     std::shared_lock<std::shared_mutex> lock(proc->pool_lock);
     std::shared_lock<std::shared_mutex> eps(proc->ep_lock);
+    std::unique_lock<std::mutex> grants(proc->grant_lock);
     if (call(AGNOCAST_IOC_TAKE, &arg, e.handle, e.id)) return;
     if (arg.pool_count && !holds_one(arg.pool, &arg.entry, arg.entry_count))
       fail("TAKE handed over a pool its entry is not in", arg.entry.entry_id, arg.pool.addr);
     map_pools(&arg.pool, arg.pool_count, wellformed);
+    grants.unlock();
     if (!arg.entry_count) return;
     count(kTakeEntry, 0);
     int topic = proc->topic_for(e.handle);
@@ -910,6 +918,7 @@ struct Worker {
     arg.pool_capacity = AGNOCAST_RECEIVE_POOLS_MAX;
     arg.release_count = static_cast<uint32_t>(released.size());
     arg.release_ids = uptr(rel);
+    std::unique_lock<std::mutex> grants(proc->grant_lock);
     int ret = call(AGNOCAST_IOC_RECEIVE, &arg, e.handle, arg.release_count);
     if (ret == 0 || ret == ENOENT || ret == ESRCH || ret == EXDEV) {
       // Released now, or not held any more (removed by another thread).
@@ -927,7 +936,13 @@ struct Worker {
       }
     if (arg.release_count) count(kReceiveReleases, 0);
     if (arg.entry_count) count(kReceiveEntries, 0);
+    for (uint32_t i = 0; i < arg.pool_count; i++) {
+      if (!holds_one(pools[i], ents, arg.entry_count))
+        fail("RECEIVE handed over a pool none of its entries is in",
+             arg.entry_count ? ents[0].entry_id : 0, pools[i].addr);
+    }
     map_pools(pools, arg.pool_count, true);
+    grants.unlock();
     const int topic = proc->topic_for(e.handle);
     for (uint32_t i = 0; i < arg.entry_count; i++) {
       held.push_back({e.handle, e.id, topic, ents[i].entry_id, ents[i].addr});

@@ -57,6 +57,12 @@ class Runtime {
 
   // Maps a publisher's pool read-only at its address and closes grant.fd.
   void map_pool(const PoolGrant& grant);
+  // The kernel hands a pool to this process once, to the RECEIVE or TAKE
+  // that needs it first; another thread's call may then return entries in it
+  // before the first thread has mapped it. Every RECEIVE and TAKE, and the
+  // mapping of the pools it was handed, hold this: no entry is returned
+  // before its pool is mapped.
+  std::mutex& grant_mutex() { return grant_mutex_; }
   // The pool mapped here (a publisher's, or this process's own) that holds
   // `address`: all a reader of a message there may touch. Empty when none does.
   std::span<const std::byte> pool_holding(const void* address);
@@ -72,6 +78,8 @@ class Runtime {
   pid_t pid_;
   void* pool_addr_;
   std::size_t pool_size_;
+
+  std::mutex grant_mutex_;
 
   mutable std::mutex pool_mutex_;
   Tlsf pool_;

@@ -395,6 +395,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
     if (!first) release_count = endpoint.take_releases(releases);
     const std::span<const std::uint64_t> released(releases.data(), release_count);
     ReceiveResult result;
+    std::unique_lock grants(runtime.grant_mutex());  // until its pools are mapped
     try {
       result = runtime.kernel().receive(state.endpoint->id(), entries, pools, released);
     } catch (...) {
@@ -408,6 +409,7 @@ std::size_t SubscriptionBase::handle_wakeup() {
     std::size_t handed_out = 0;  // deliver() owns every reference it was given
     try {
       map_pools(runtime, std::span(pools.data(), result.pool_count));
+      grants.unlock();
       while (handed_out < result.entry_count) {
         const std::size_t i = handed_out++;
         deliver(reinterpret_cast<const void*>(entries[i].addr), references[i],
@@ -456,6 +458,7 @@ std::uint32_t PollingCore::id() const { return state_->endpoint->id().id; }
 // makes it the latest. Returns false when there is none.
 bool PollingCore::take_newer() {
   SubscriberEndpoint& endpoint = *state_->endpoint;
+  std::unique_lock grants(endpoint.runtime().grant_mutex());  // until its pool is mapped
   const TakeResult taken = endpoint.runtime().kernel().take(endpoint.id());
   EntryReference* reference =
       taken.has_entry ? endpoint.reference_to(taken.entry.entry_id, state_->endpoint) : nullptr;
@@ -467,6 +470,7 @@ bool PollingCore::take_newer() {
       throw;
     }
   }
+  grants.unlock();
   if (!reference) return false;
   if (state_->latest.reference) release(state_->latest.reference);
   state_->latest = TakenEntry{reinterpret_cast<const void*>(taken.entry.addr), reference};

@@ -40,8 +40,6 @@ static int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns,
 
 	ctx->proc = NULL;
 	ctx->write = write;
-	/* After exec, the old program's registration is gone before the new one calls. */
-	agnocast_proc_settle_current();
 	/*
 	 * The open file holds a reference on the state of the namespace it was
 	 * opened in; while the caller is still in that namespace, use it and
@@ -51,6 +49,7 @@ static int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns,
 	ctx->ns = ctx->ns_from_file ? file_ns : agnocast_ns_get_current();
 	if (!ctx->ns)
 		return -ENOMEM;
+relock:
 	ret = write ? down_write_killable(&ctx->ns->lock) : down_read_killable(&ctx->ns->lock);
 	if (ret) {
 		if (!ctx->ns_from_file)
@@ -58,6 +57,15 @@ static int agnocast_enter(struct agnocast_ctx *ctx, struct agnocast_ns *file_ns,
 		return ret;
 	}
 	ret = agnocast_proc_find_current(ctx->ns, &ctx->proc);
+	if (ret == -EAGAIN) {
+		/* After exec, the old program's registration goes before the new one calls. */
+		if (write)
+			up_write(&ctx->ns->lock);
+		else
+			up_read(&ctx->ns->lock);
+		agnocast_proc_settle();
+		goto relock;
+	}
 	if (!ret && registered && !ctx->proc)
 		ret = -ESRCH;
 	if (ret)

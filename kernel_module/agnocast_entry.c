@@ -489,9 +489,23 @@ u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *
 	proc->nr_reclaim -= n;
 	*pending = proc->nr_reclaim;
 	spin_unlock(&proc->reclaim_lock);
-	list_for_each_entry_safe(entry, tmp, &taken, node)
-		agnocast_entry_free(entry);
+	list_for_each_entry_safe(entry, tmp, &taken, node) {
+		/* One is kept for the next PUBLISH: its allocation is the dearest step. */
+		if (cmpxchg(&proc->spare_entry, NULL, entry))
+			agnocast_entry_free(entry);
+	}
 	return n;
+}
+
+/* A zeroed entry for @proc's PUBLISH: its spare if it has one. */
+struct agnocast_topic_entry *agnocast_proc_entry_alloc(struct agnocast_proc *proc)
+{
+	struct agnocast_topic_entry *entry = xchg(&proc->spare_entry, NULL);
+
+	if (!entry)
+		return agnocast_entry_alloc();
+	memset(entry, 0, sizeof(*entry));
+	return entry;
 }
 
 /*
@@ -529,4 +543,7 @@ void agnocast_proc_drop_reclaim(struct agnocast_proc *proc)
 		agnocast_entry_free(entry);
 	INIT_LIST_HEAD(&proc->reclaim);
 	proc->nr_reclaim = 0;
+	if (proc->spare_entry)
+		agnocast_entry_free(proc->spare_entry);
+	proc->spare_entry = NULL;
 }

@@ -42,11 +42,21 @@
 #include <linux/slab.h>
 #include <linux/types.h>
 #include <linux/uidgid.h>
+#include <linux/version.h>
 #include <linux/wait.h>
 #include <linux/workqueue.h>
 #include <linux/xarray.h>
 
+#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 12, 0)
+#include <linux/unaligned.h>
+#else
+#include <asm/unaligned.h>
+#endif
+
 #include "agnocast.h"
+
+/* Endpoints a process finds again without a lookup (a power of two). */
+#define AGNOCAST_RECENT_ENDPOINTS 8
 
 /* Unreferenced id spaces kept so that topic_local_ids are not reused soon. */
 #define AGNOCAST_DORMANT_ID_SPACES_MAX 1024
@@ -145,6 +155,18 @@ struct agnocast_proc {
 	/* Protected by @reclaim_lock. */
 	struct list_head reclaim;	/* freed entries of this process's pool */
 	unsigned int nr_reclaim;
+	/*
+	 * An entry whose address a PUBLISH or RECLAIM returned, kept for the
+	 * process's next PUBLISH instead of freed (xchg/cmpxchg).
+	 */
+	struct agnocast_topic_entry *spare_entry;
+	/*
+	 * The process's endpoints it named last, by (topic handle, id): the
+	 * data path finds them without walking two trees.  Stored under the
+	 * namespace lock held for read (racing stores are equally right),
+	 * cleared under it held for write when the endpoint goes.
+	 */
+	struct agnocast_endpoint *recent_endpoints[AGNOCAST_RECENT_ENDPOINTS];
 };
 
 /* Names equal after mangling share one topic_local_id counter. */
@@ -301,7 +323,7 @@ ssize_t agnocast_read_exit_records(struct agnocast_ns *ns, char __user *buf,
 /* agnocast_process.c: registered processes, exit detection, teardown. */
 int agnocast_process_init(void);
 void agnocast_process_exit(void);
-void agnocast_proc_settle_current(void);
+void agnocast_proc_settle(void);
 int agnocast_proc_find_current(struct agnocast_ns *ns, struct agnocast_proc **out);
 struct agnocast_proc *agnocast_proc_create(struct agnocast_ns *ns);
 void agnocast_proc_unregister(struct agnocast_proc *proc);
@@ -359,6 +381,7 @@ void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct agnocast_e
 int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n);
 u32 agnocast_proc_shed(struct agnocast_proc *proc, u32 *reclaimable);
 u32 agnocast_reclaim_take(struct agnocast_proc *proc, u64 *addrs, u32 max, u32 *pending);
+struct agnocast_topic_entry *agnocast_proc_entry_alloc(struct agnocast_proc *proc);
 void agnocast_reclaim_return(struct agnocast_proc *proc, const u64 *addrs, u32 n);
 void agnocast_proc_drop_reclaim(struct agnocast_proc *proc);
 
@@ -406,6 +429,66 @@ void agnocast_leave(struct agnocast_ctx *ctx);
 int agnocast_unwritable(struct agnocast_ns *file_ns);
 
 /*
+ * The data path's arguments and answers are a few words each, moved here a
+ * word at a time in one user-access window: copy_from_user() and
+ * copy_to_user() move them a byte at a time (a string instruction, or a byte
+ * loop under 64 bytes), which costs more than the call's own work.  Larger
+ * ones still go through them.  @bytes is a multiple of 4; none is no access
+ * at all, as with copy_from_user(), whatever the pointer.
+ */
+#define AGNOCAST_WORDS_MAX 256
+
+static __always_inline int agnocast_words_in(void *to, const void __user *from, size_t bytes)
+{
+	size_t i;
+	u64 word;
+	u32 half;
+
+	if (!bytes)
+		return 0;
+	if (bytes > AGNOCAST_WORDS_MAX)
+		return copy_from_user(to, from, bytes) ? -EFAULT : 0;
+	if (!user_access_begin(from, bytes))
+		return -EFAULT;
+	for (i = 0; i + sizeof(u64) <= bytes; i += sizeof(u64)) {
+		unsafe_get_user(word, (const u64 __user *)(from + i), efault);
+		put_unaligned(word, (u64 *)(to + i));
+	}
+	if (i < bytes) {
+		unsafe_get_user(half, (const u32 __user *)(from + i), efault);
+		put_unaligned(half, (u32 *)(to + i));
+	}
+	user_access_end();
+	return 0;
+efault:
+	user_access_end();
+	return -EFAULT;
+}
+
+static __always_inline int agnocast_words_out(void __user *to, const void *from, size_t bytes)
+{
+	size_t i;
+
+	if (!bytes)
+		return 0;
+	if (bytes > AGNOCAST_WORDS_MAX)
+		return copy_to_user(to, from, bytes) ? -EFAULT : 0;
+	if (!user_access_begin(to, bytes))
+		return -EFAULT;
+	for (i = 0; i + sizeof(u64) <= bytes; i += sizeof(u64))
+		unsafe_put_user(get_unaligned((const u64 *)(from + i)), (u64 __user *)(to + i),
+				efault);
+	if (i < bytes)
+		unsafe_put_user(get_unaligned((const u32 *)(from + i)), (u32 __user *)(to + i),
+				efault);
+	user_access_end();
+	return 0;
+efault:
+	user_access_end();
+	return -EFAULT;
+}
+
+/*
  * Checks @bytes at @ubuf writable, keeping what the caller has there (on
  * every PUBLISH and RECEIVE: inline).
  */
@@ -417,7 +500,7 @@ static inline int agnocast_out_writable(u64 ubuf, size_t bytes)
 
 	if (!bytes)
 		return 0;
-	if (!access_ok(p, bytes))
+	if (!user_access_begin(p, bytes))
 		return -EFAULT;
 	/*
 	 * One byte of each page, written back with its own value: the page is
@@ -426,17 +509,21 @@ static inline int agnocast_out_writable(u64 ubuf, size_t bytes)
 	 * through get_user_pages for every call.
 	 */
 	while (p < end) {
-		if (get_user(c, p) || put_user(c, p))
-			return -EFAULT;
+		unsafe_get_user(c, p, efault);
+		unsafe_put_user(c, p, efault);
 		p = (char __user *)PAGE_ALIGN((unsigned long)p + 1);
 	}
+	user_access_end();
 	return 0;
+efault:
+	user_access_end();
+	return -EFAULT;
 }
 
 /* Writes an answer after commit; a failure loses only the answer. */
 static inline bool agnocast_answer_out(void __user *to, const void *from, size_t bytes)
 {
-	return !copy_to_user(to, from, bytes);
+	return !agnocast_words_out(to, from, bytes);
 }
 
 /* agnocast_grant.c: pools handed to a subscriber (RECEIVE, TAKE). */

@@ -183,7 +183,7 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	u32 wake_max, reclaim_max, wake_count = 0;
 	int ret;
 
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
+	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
 	if (arg.reserved)
 		return -EINVAL;
@@ -220,7 +220,7 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 		if (!wake)
 			goto out_leave;
 	}
-	entry = agnocast_entry_alloc();
+	entry = agnocast_proc_entry_alloc(ctx.proc);
 	if (!entry)
 		goto out_leave;
 
@@ -255,7 +255,7 @@ int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
 	u32 reclaim_max;
 	int ret;
 
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
+	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
 	if (arg.reserved)
 		return -EINVAL;
@@ -288,7 +288,7 @@ static int agnocast_release_ids_in(u64 uids, u32 count, u64 *small, u64 **ids)
 		if (!*ids)
 			return -ENOMEM;
 	}
-	if (copy_from_user(*ids, u64_to_user_ptr(uids), count * sizeof(u64))) {
+	if (agnocast_words_in(*ids, u64_to_user_ptr(uids), count * sizeof(u64))) {
 		if (*ids != small)
 			kvfree(*ids);
 		*ids = small;
@@ -314,7 +314,7 @@ int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg)
 	u32 n, i, entry_max, installed = 0;
 	int ret;
 
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
+	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
 	if (!arg.entry_capacity || !arg.pool_capacity || arg.release_count > AGNOCAST_RELEASE_MAX)
 		return -EINVAL;
@@ -420,7 +420,7 @@ int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg)
 	u32 attempts = 0;
 	int ret;
 
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
+	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
 	if (arg.flags || arg.reserved)
 		return -EINVAL;
@@ -501,7 +501,7 @@ int agnocast_release(struct agnocast_ns *file_ns, void __user *uarg)
 	u64 *ids;
 	int ret;
 
-	if (copy_from_user(&arg, uarg, sizeof(arg)))
+	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
 	if (arg.flags || !arg.count)
 		return -EINVAL;

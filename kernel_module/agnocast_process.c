@@ -19,8 +19,8 @@
  *
  * Calls find the caller's record by tgid under RCU, without a lock: records
  * leave the table under the raw spinlock and are freed after a grace period.
- * A dying record is invisible, so a call racing with teardown sees the
- * process unregistered.
+ * A call that finds its process's record dying waits for the teardown
+ * (the old program's, after exec), so it sees the process unregistered.
  */
 #include <linux/bitmap.h>
 #include <linux/cred.h>
@@ -119,21 +119,6 @@ static void agnocast_teardown_work(struct work_struct *work)
 	agnocast_proc_teardown(proc, true);
 	up_write(&ns->lock);
 	agnocast_ns_put(ns);
-}
-
-/* Whether a registration of @tgid is dying but not torn down yet. */
-static bool agnocast_proc_pending(pid_t tgid)
-{
-	struct agnocast_proc *proc;
-	bool pending = false;
-
-	rcu_read_lock();
-	hash_for_each_possible_rcu(agnocast_proc_table, proc, table_node, tgid) {
-		if (proc->tgid == tgid && READ_ONCE(proc->dying))
-			pending = true;
-	}
-	rcu_read_unlock();
-	return pending;
 }
 
 /* Marks @tgid's registration dying and queues its teardown. */
@@ -242,31 +227,42 @@ void agnocast_process_exit(void)
 	rcu_barrier();
 }
 
-/* After exec, waits until the old program's registration is gone. */
-void agnocast_proc_settle_current(void)
+/* Waits until the registrations that are dying are torn down. */
+void agnocast_proc_settle(void)
 {
-	if (unlikely(agnocast_proc_pending(current->tgid)))
-		flush_workqueue(agnocast_wq);
+	flush_workqueue(agnocast_wq);
 }
 
 /*
  * The caller's registration in @ns, NULL if none (@ns->lock held, under which
- * a record of the namespace stays); -EXDEV if it is registered in another.
+ * a record of the namespace stays); -EXDEV if it is registered in another;
+ * -EAGAIN while a registration of its process is dying (the old program's,
+ * after exec): drop the lock, agnocast_proc_settle(), and look again.
  */
 int agnocast_proc_find_current(struct agnocast_ns *ns, struct agnocast_proc **out)
 {
-	struct agnocast_proc *proc;
+	struct agnocast_proc *proc, *found = NULL;
+	pid_t tgid = current->tgid;
 	int ret = 0;
 
 	lockdep_assert_held(&ns->lock);
 	rcu_read_lock();
-	proc = agnocast_proc_lookup(current->tgid);
-	if (proc && proc->ns != ns) {
-		proc = NULL;
+	hash_for_each_possible_rcu(agnocast_proc_table, proc, table_node, tgid) {
+		if (proc->tgid != tgid)
+			continue;
+		if (READ_ONCE(proc->dying)) {
+			ret = -EAGAIN;
+			found = NULL;
+			break;
+		}
+		found = proc;
+	}
+	if (found && found->ns != ns) {
+		found = NULL;
 		ret = -EXDEV;
 	}
 	rcu_read_unlock();
-	*out = proc;
+	*out = found;
 	return ret;
 }
 

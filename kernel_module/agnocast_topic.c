@@ -18,7 +18,9 @@
  * for write and are looked up with it held at least for read; what the entry
  * engine keeps of a topic is under the topic's own lock.
  */
+#include <linux/hash.h>
 #include <linux/jhash.h>
+#include <linux/log2.h>
 #include <linux/minmax.h>
 #include <linux/slab.h>
 #include <linux/string.h>
@@ -381,6 +383,24 @@ void agnocast_endpoint_commit(struct agnocast_endpoint *ep)
 	proc->nr_subscribers++;
 }
 
+/* Where @proc keeps its endpoint @id of topic @handle among its recent ones. */
+static struct agnocast_endpoint **agnocast_endpoint_recent(struct agnocast_proc *proc,
+							     u32 handle, u32 id)
+{
+	return &proc->recent_endpoints[hash_32(handle ^ (id << 16) ^ (id >> 16),
+					       ilog2(AGNOCAST_RECENT_ENDPOINTS))];
+}
+
+/* Takes @ep out of its process's recent endpoints (lock held for write). */
+static void agnocast_endpoint_forget(struct agnocast_endpoint *ep)
+{
+	struct agnocast_endpoint **recent = agnocast_endpoint_recent(ep->proc, ep->topic->handle,
+								     ep->id);
+
+	if (*recent == ep)
+		*recent = NULL;
+}
+
 /* Drops the endpoint and its references; the caller frees the topic if idle. */
 void agnocast_endpoint_destroy(struct agnocast_endpoint *ep)
 {
@@ -388,6 +408,7 @@ void agnocast_endpoint_destroy(struct agnocast_endpoint *ep)
 	struct agnocast_proc *proc = ep->proc;
 
 	lockdep_assert_held_write(&topic->ns->lock);
+	agnocast_endpoint_forget(ep);
 	xa_erase(&topic->endpoints, ep->id);
 	list_del(&ep->topic_node);
 	list_del(&ep->proc_node);
@@ -413,9 +434,15 @@ void agnocast_endpoint_destroy(struct agnocast_endpoint *ep)
 int agnocast_endpoint_lookup(struct agnocast_ns *ns, struct agnocast_proc *proc, u32 handle,
 			     u32 id, bool publisher, struct agnocast_endpoint **out)
 {
-	struct agnocast_topic *topic = agnocast_topic_by_handle(ns, handle);
-	struct agnocast_endpoint *ep;
+	struct agnocast_endpoint **recent = agnocast_endpoint_recent(proc, handle, id);
+	struct agnocast_endpoint *ep = READ_ONCE(*recent);
+	struct agnocast_topic *topic;
 
+	if (ep && ep->id == id && ep->topic->handle == handle && ep->publisher == publisher) {
+		*out = ep;
+		return 0;
+	}
+	topic = agnocast_topic_by_handle(ns, handle);
 	if (!topic)
 		return -ENOENT;
 	ep = xa_load(&topic->endpoints, id);
@@ -423,6 +450,7 @@ int agnocast_endpoint_lookup(struct agnocast_ns *ns, struct agnocast_proc *proc,
 		return -ENOENT;
 	if (ep->proc != proc)
 		return -EPERM;
+	WRITE_ONCE(*recent, ep);
 	*out = ep;
 	return 0;
 }

@@ -644,11 +644,7 @@ struct Worker {
     // answer is where the kernel wrote it.
     const auto* got = reinterpret_cast<const agnocast_entry*>(arg.entries);
     const auto* got_pools = reinterpret_cast<const agnocast_pool*>(arg.pools);
-    for (uint32_t i = 0; i < arg.pool_count; i++) {
-      if (!holds_one(got_pools[i], got, arg.entry_count))
-        fail("RECEIVE handed over a pool none of its entries is in",
-             arg.entry_count ? got[0].entry_id : 0, got_pools[i].addr);
-    }
+    check_receive_pools(got_pools, arg.pool_count, got, arg.entry_count);
     map_pools(got_pools, arg.pool_count, false);
     grants.unlock();
     int topic = proc->topic_for(e.handle);
@@ -663,6 +659,16 @@ struct Worker {
     return std::any_of(entries, entries + n, [&](const agnocast_entry& e) {
       return e.addr >= pool.addr && e.addr < pool.addr + pool.size;
     });
+  }
+
+  // Every pool a RECEIVE hands over holds one of the entries it returned.
+  void check_receive_pools(const agnocast_pool* pools, uint32_t pool_count,
+                           const agnocast_entry* entries, uint32_t entry_count) {
+    for (uint32_t i = 0; i < pool_count; i++) {
+      if (!holds_one(pools[i], entries, entry_count))
+        fail("RECEIVE handed over a pool none of its entries is in",
+             entry_count ? entries[0].entry_id : 0, pools[i].addr);
+    }
   }
 
   void do_take(Ep e, bool wellformed) {
@@ -936,11 +942,7 @@ struct Worker {
       }
     if (arg.release_count) count(kReceiveReleases, 0);
     if (arg.entry_count) count(kReceiveEntries, 0);
-    for (uint32_t i = 0; i < arg.pool_count; i++) {
-      if (!holds_one(pools[i], ents, arg.entry_count))
-        fail("RECEIVE handed over a pool none of its entries is in",
-             arg.entry_count ? ents[0].entry_id : 0, pools[i].addr);
-    }
+    check_receive_pools(pools, arg.pool_count, ents, arg.entry_count);
     map_pools(pools, arg.pool_count, true);
     grants.unlock();
     const int topic = proc->topic_for(e.handle);

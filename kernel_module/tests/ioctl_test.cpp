@@ -492,6 +492,47 @@ TEST_F(Device, RemoveEndpoint) {
   drain_exit_records(dev);
 }
 
+// The data path finds the endpoints a process used last without a lookup;
+// one removed must be refused at once, and an id given again must name the
+// new endpoint, not the old one.
+TEST_F(Device, RemovedEndpointIsRefusedRightAfterUse) {
+  registered();
+  Endpoint pub, sub;
+  ASSERT_EQ(add_publisher(dev, "/recent", 2, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/recent", 2, &sub), 0);
+  Endpoint keep;  // keeps the topic, and its handle, alive
+  ASSERT_EQ(add_subscriber(dev, "/recent", 2, &keep), 0);
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64), 0);
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, sub, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  agnocast_remove_endpoint rm{pub.handle, pub.id};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_PUBLISHER, &rm), 0);
+  rm = {sub.handle, sub.id};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), 0);
+  EXPECT_EQ(publish(dev, pub, reg.addr + 128), -ENOENT);
+  EXPECT_EQ(receive(dev, sub, &rr), -ENOENT);
+  EXPECT_EQ(release(dev, sub, 0), -ENOENT);
+
+  // New endpoints of the same topic, which may get the old ids back.
+  Endpoint pub2, sub2;
+  ASSERT_EQ(add_subscriber(dev, "/recent", 2, &sub2), 0);
+  ASSERT_EQ(add_publisher(dev, "/recent", 2, &pub2), 0);
+  if (sub2.id == pub.id) {
+    EXPECT_EQ(publish(dev, pub, reg.addr + 128), -ENOENT);
+  }
+  if (pub2.id == sub.id) {
+    EXPECT_EQ(receive(dev, sub, &rr), -ENOENT);
+  }
+  PublishResult res;
+  ASSERT_EQ(publish(dev, pub2, reg.addr + 192, &res), 0);
+  ASSERT_EQ(receive(dev, sub2, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  EXPECT_EQ(rr.entries[0].entry_id, res.entry_id);
+  EXPECT_EQ(rr.entries[0].publisher_id, pub2.id);
+  drain_exit_records(dev);
+}
+
 TEST_F(Device, PublishReceiveRelease) {
   registered();
   Endpoint pub, cb, poll;

@@ -524,21 +524,21 @@ void print_why_latency_stands(const json& icount) {
   const double budget = std::min(
       {12000.0, floor * 1000 * 1.5, std::isnan(iceoryx) ? 12000.0 : iceoryx * 1000 * 0.85});
   const double rest = ours * 1000 - kernel_path;
+  const bool fits = rest <= budget - kernel_path;
   std::printf(
-      "\nWhy the one-way targets stand where they do: agnocast's window holds the mqueue hop "
-      "it shares with the floor (`mq_send` to the return from `epoll_wait`, %.0f instructions: "
-      "the floor's %.0f less its `mq_receive`, which agnocast's subscriber makes after the "
-      "callback) and its own two ioctls (PUBLISH %.0f, RECEIVE %.0f): %.0f before any of the "
-      "library's user space runs.  The 64 B p50 is %.0f; the rest of the window, %.0f, is "
-      "mostly the library's own code (the publish call on one side; the executor's wake-up, "
-      "the receive loop and the callback's dispatch on the other).  The strictest of the three "
-      "targets (12,000; 1.5 × the floor; 0.85 × iceoryx) is %.0f, which leaves that rest "
-      "%.0f: %s.  The fan-out slope stays near 2 for the same reason: each further subscriber "
-      "is woken by an `mq_send` of its own, as in the mqueue series, and then also makes its "
-      "RECEIVE, takes its notification and runs the library's wake-up, all on the one vCPU "
-      "before the last subscriber's callback.\n",
+      "\nWhere the one-way time goes: agnocast's window holds the mqueue hop it shares with "
+      "the floor (`mq_send` to the return from `epoll_wait`, %.0f instructions: the floor's "
+      "%.0f less its `mq_receive`, which agnocast's subscriber makes after the callback) and "
+      "its own two ioctls (PUBLISH %.0f, RECEIVE %.0f): %.0f before any of the library's user "
+      "space runs.  The 64 B p50 is %.0f; the rest of the window, %.0f, is mostly the "
+      "library's own code (the publish call on one side; the executor's wake-up, the receive "
+      "loop and the callback's dispatch on the other).  The strictest of the three targets "
+      "(12,000; 1.5 × the floor; 0.85 × iceoryx) is %.0f, which leaves that rest %.0f: %s.  "
+      "Each further fan-out subscriber is woken by an `mq_send` of its own, as in the mqueue "
+      "series, and then also makes its RECEIVE, takes its notification and runs the "
+      "library's wake-up, all on the one vCPU before the last subscriber's callback.\n",
       hop - mq_receive, hop, publish, receive, kernel_path, ours * 1000, rest, budget,
-      budget - kernel_path, rest <= budget - kernel_path ? "it fits" : "less than it takes now");
+      budget - kernel_path, fits ? "it fits" : "less than it takes now");
 }
 
 }  // namespace
@@ -717,8 +717,8 @@ depend on it.
   }
   std::printf(
       "- extra cost per fan-out subscriber ≤ 1.5 × the plain mqueue wake-up's (`fanout_slope`): "
-      "%s (%s against %s µs per subscriber; the window still holds each earlier subscriber's "
-      "payload check of the benchmark, 4 KiB)\n",
+      "%s (%s against %s µs per subscriber; each subscriber checks its 4 KiB payload once "
+      "all have it, outside the window)\n",
       standing(at_path(icount, {"ratios", "fanout_slope"}), 1.5, "%.2f").c_str(),
       number(at_path(icount, {"fanout_slope_us_per_subscriber", "agnocast"}), "%.1f").c_str(),
       number(at_path(icount, {"fanout_slope_us_per_subscriber", "mqueue"}), "%.1f").c_str());

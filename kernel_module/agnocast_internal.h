@@ -444,6 +444,7 @@ static __always_inline int agnocast_words_in(void *to, const void __user *from, 
 	u64 word;
 	u32 half;
 
+	BUILD_BUG_ON(__builtin_constant_p(bytes) && bytes % sizeof(u32));
 	if (!bytes)
 		return 0;
 	if (bytes > AGNOCAST_WORDS_MAX)
@@ -469,6 +470,7 @@ static __always_inline int agnocast_words_out(void __user *to, const void *from,
 {
 	size_t i;
 
+	BUILD_BUG_ON(__builtin_constant_p(bytes) && bytes % sizeof(u32));
 	if (!bytes)
 		return 0;
 	if (bytes > AGNOCAST_WORDS_MAX)

@@ -1,50 +1,24 @@
 #include "syscall_counter.hpp"
 
-#include <linux/perf_event.h>
-#include <sys/ioctl.h>
-#include <sys/mount.h>
-#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 
+#include "tracepoint_counter.hpp"
+
 namespace agnocast::bench {
-namespace {
-
-constexpr const char* tracefs = "/sys/kernel/tracing";
-
-std::optional<std::uint64_t> tracepoint_id(const std::string& event) {
-  std::ifstream file(std::string(tracefs) + "/events/" + event + "/id");
-  std::uint64_t id = 0;
-  if (!(file >> id)) return std::nullopt;
-  return id;
-}
-
-int open_counter(std::uint64_t id, int group_fd) {
-  perf_event_attr attr{};
-  attr.type = PERF_TYPE_TRACEPOINT;
-  attr.size = sizeof attr;
-  attr.config = id;
-  attr.read_format = PERF_FORMAT_GROUP;
-  return static_cast<int>(syscall(SYS_perf_event_open, &attr, 0, -1, group_fd, 0));
-}
-
-}  // namespace
 
 std::optional<SyscallCounter> SyscallCounter::open(const std::vector<std::string>& names,
                                                    std::string* why) {
-  if (!tracepoint_id("raw_syscalls/sys_enter")) {
-    mount("tracefs", tracefs, "tracefs", 0, nullptr);
-  }
   SyscallCounter counter;
   std::vector<std::pair<std::string, std::string>> events{{"total", "raw_syscalls/sys_enter"}};
   for (const auto& name : names) events.emplace_back(name, "syscalls/sys_enter_" + name);
   for (const auto& [name, event] : events) {
     const auto id = tracepoint_id(event);
-    const int fd = id ? open_counter(*id, counter.fds_.empty() ? -1 : counter.fds_.front()) : -1;
+    const int group_fd = counter.fds_.empty() ? -1 : counter.fds_.front();
+    const int fd = id ? open_tracepoint_counter(*id, 0, -1, group_fd, 0, true) : -1;
     if (fd < 0) {
       *why = "no counter for " + event + ": " +
              (id ? std::string(std::strerror(errno)) : std::string("no tracepoint in tracefs"));

@@ -4,23 +4,19 @@
 #include <linux/perf_event.h>
 #include <sched.h>
 #include <sys/ioctl.h>
-#include <sys/mount.h>
-#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <utility>
 
 #include "bench_support.hpp"
+#include "tracepoint_counter.hpp"
 
 namespace agnocast::bench {
 namespace {
-
-constexpr const char* tracefs = "/sys/kernel/tracing";
 
 struct Event {
   const char* name;
@@ -46,25 +42,9 @@ const Event events[] = {
     {"lock_contentions", "lock/contention_begin", nullptr},
 };
 
-std::optional<std::uint64_t> tracepoint_id(const std::string& event) {
-  std::ifstream file(std::string(tracefs) + "/events/" + event + "/id");
-  std::uint64_t id = 0;
-  if (!(file >> id)) return std::nullopt;
-  return id;
-}
-
-int open_on_cpu(std::uint64_t id, int cpu) {
-  perf_event_attr attr{};
-  attr.type = PERF_TYPE_TRACEPOINT;
-  attr.size = sizeof attr;
-  attr.config = id;
-  return static_cast<int>(syscall(SYS_perf_event_open, &attr, -1, cpu, -1, PERF_FLAG_FD_CLOEXEC));
-}
-
 }  // namespace
 
 std::optional<WindowCounters> WindowCounters::open(std::string* why) {
-  if (!tracepoint_id("sched/sched_switch")) mount("tracefs", tracefs, "tracefs", 0, nullptr);
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
   WindowCounters counters;
   for (const Event& event : events) {
@@ -73,7 +53,7 @@ std::optional<WindowCounters> WindowCounters::open(std::string* why) {
     counters.names_.emplace_back(event.name);
     std::vector<int>& fds = counters.fds_.emplace_back();
     for (int cpu = 0; cpu < cpus; ++cpu) {
-      const int fd = open_on_cpu(*id, cpu);
+      const int fd = open_tracepoint_counter(*id, -1, cpu, -1, PERF_FLAG_FD_CLOEXEC, false);
       if (fd >= 0) fds.push_back(fd);
       if (fd >= 0 && event.filter && ioctl(fd, PERF_EVENT_IOC_SET_FILTER, event.filter) != 0) {
         *why = std::string("filter on ") + event.tracepoint + ": " + std::strerror(errno);

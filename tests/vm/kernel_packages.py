@@ -65,7 +65,8 @@ class AptCache:
             if found:
                 candidate = None if found.group(1) == "(none)" else found.group(1)
                 continue
-            found = re.match(r"^\s{5}(?:\*\*\*)?\s*(\S+)\s+-?\d+$", line)
+            # "     6.1.192-2 500", or " *** 6.1.192-3 500" when installed
+            found = re.match(r"^\s+(?:\*\*\*\s+)?(\S+)\s+-?\d+$", line)
             if found:
                 current = table.setdefault(found.group(1), [])
                 continue

@@ -87,6 +87,21 @@ def test_no_version_of_an_unconstrained_package_but_the_candidate():
         "linux-kbuild-6.12.95+deb12", "6.12.95-1~bpo12+1")
 
 
+def test_an_installed_version_is_offered_too():
+    # The host installed linux-kbuild-6.1 6.1.192-3: policy marks it with ***
+    # and lists dpkg's status beside the archive.
+    text = recorded("rt-kbuild-rebuilt.txt").replace(
+        """     6.1.192-3 500
+        500 http://deb.debian.org/debian-security bookworm-security/main amd64 Packages
+""",
+        """ *** 6.1.192-3 500
+        500 http://deb.debian.org/debian-security bookworm-security/main amd64 Packages
+        100 /var/lib/dpkg/status
+""")
+    assert text != recorded("rt-kbuild-rebuilt.txt")
+    assert resolve(text, "linux-image-rt-amd64")[-1] == ("linux-kbuild-6.1", "6.1.192-3")
+
+
 def test_a_missing_kbuild_names_the_package_and_the_versions_offered():
     text = recorded("rt-kbuild-rebuilt.txt").replace(
         """     6.1.192-3 500

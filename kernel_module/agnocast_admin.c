@@ -8,6 +8,7 @@
  * and the policy (agnocast_policy.c), leaves, and copies its answer out.
  */
 #include <linux/capability.h>
+#include <linux/eventfd.h>
 #include <linux/ipc_namespace.h>
 #include <linux/nsproxy.h>
 #include <linux/overflow.h>
@@ -20,19 +21,27 @@
 int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_register_process arg;
+	struct eventfd_ctx *wake = NULL;
 	struct agnocast_ctx ctx;
 	int ret;
 
 	if (copy_from_user(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	if (arg.flags || arg.reserved)
+	if (arg.flags & ~AGNOCAST_REGISTER_WAKE_EVENTFD)
+		return -EINVAL;
+	if (!(arg.flags & AGNOCAST_REGISTER_WAKE_EVENTFD) && arg.wake_fd)
 		return -EINVAL;
 	if (arg.pool_fd < -1)
 		return -EBADF;
+	if (arg.flags & AGNOCAST_REGISTER_WAKE_EVENTFD) {
+		wake = eventfd_ctx_fdget(arg.wake_fd);
+		if (IS_ERR(wake))
+			return PTR_ERR(wake);
+	}
 
 	ret = agnocast_enter_ns_write(&ctx, file_ns);
 	if (ret)
-		return ret;
+		goto out_put;
 	if (arg.pool_fd == -1) {
 		if (!ctx.proc) {
 			ctx.proc = agnocast_proc_create(ctx.ns);
@@ -46,17 +55,22 @@ int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg)
 	} else {
 		ret = agnocast_pool_attach(ctx.proc->pool, arg.pool_fd);
 	}
+	if (ctx.proc && !ret && wake) {
+		agnocast_wake_set_eventfd(ctx.proc, wake);
+		wake = NULL;
+	}
 	if (ctx.proc && !ret) {
 		arg.pid = task_tgid_vnr(current);
 		arg.pool_addr = ctx.proc->pool->addr;
 		arg.pool_size = ctx.proc->pool->size;
 	}
 	agnocast_leave(&ctx);
-	if (ret)
-		return ret;
-	if (copy_to_user(uarg, &arg, sizeof(arg)))
-		return -EFAULT;
-	return 0;
+	if (!ret && copy_to_user(uarg, &arg, sizeof(arg)))
+		ret = -EFAULT;
+out_put:
+	if (wake)
+		eventfd_ctx_put(wake);
+	return ret;
 }
 
 int agnocast_unregister_process(struct agnocast_ns *file_ns)

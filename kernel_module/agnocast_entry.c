@@ -122,19 +122,18 @@ static void agnocast_sub_push(struct agnocast_subscriber *sub,
 }
 
 /*
- * Whether @sub is woken for a new entry: a callback subscriber is, through
- * its notification queue, but one with AGNOCAST_WAKE_ONCE only if it was not
- * woken since it last looked (RECEIVE or TAKE); a polling one never is.
+ * Whether @sub is woken for a new entry of @pub: a callback subscriber is,
+ * through its notification queue, but one with AGNOCAST_WAKE_ONCE only if it
+ * was not woken since it last looked (RECEIVE or TAKE); a polling one never
+ * is.  A listing is a promise (agnocast_wake_promise()).
  */
-static bool agnocast_sub_wake(struct agnocast_subscriber *sub)
+static bool agnocast_sub_wake(struct agnocast_subscriber *sub, struct agnocast_publisher *pub)
 {
 	if (sub->ep.flags & AGNOCAST_POLLING)
 		return false;
-	if (!(sub->ep.flags & AGNOCAST_WAKE_ONCE))
-		return true;
-	if (sub->notified)
+	if ((sub->ep.flags & AGNOCAST_WAKE_ONCE) && sub->notified)
 		return false;
-	sub->notified = true;
+	agnocast_wake_promise(sub, pub->ep.proc);
 	return true;
 }
 
@@ -144,7 +143,7 @@ static bool agnocast_sub_wake(struct agnocast_subscriber *sub)
  */
 static void agnocast_sub_looks(struct agnocast_subscriber *sub)
 {
-	sub->notified = false;
+	WRITE_ONCE(sub->notified, false);
 }
 
 /*
@@ -181,7 +180,7 @@ u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic
 			continue;
 		sub = agnocast_to_subscriber(ep);
 		agnocast_sub_push(sub, entry);
-		if (!agnocast_sub_wake(sub))
+		if (!agnocast_sub_wake(sub, pub))
 			continue;
 		if (!WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
 			wake[nr_wake++] = ep->id;

@@ -39,6 +39,8 @@
 #include <linux/rwsem.h>
 #include <linux/spinlock.h>
 #include <linux/pid.h>
+#include <linux/jiffies.h>
+#include <linux/timer.h>
 #include <linux/slab.h>
 #include <linux/types.h>
 #include <linux/uidgid.h>
@@ -167,6 +169,8 @@ struct agnocast_proc {
 	 * cleared under it held for write when the endpoint goes.
 	 */
 	struct agnocast_endpoint *recent_endpoints[AGNOCAST_RECENT_ENDPOINTS];
+	/* Signalled when a notification to a subscriber of it may be lost. */
+	struct eventfd_ctx *wake_eventfd;
 };
 
 /* Names equal after mangling share one topic_local_id counter. */
@@ -240,8 +244,16 @@ struct agnocast_subscriber {
 	u32 held_capacity;
 	u64 received;
 	u64 dropped;
-	/* AGNOCAST_WAKE_ONCE: woken by a PUBLISH since its last RECEIVE or TAKE. */
+	/*
+	 * Callback subscribers: listed by a PUBLISH since the last RECEIVE or
+	 * TAKE (a wake-once one is listed again only when this is false), when
+	 * first, by which process (compared, never followed); and what breaks
+	 * that promise when it is not kept (agnocast_wake.c).
+	 */
 	bool notified;
+	unsigned long notified_at;
+	struct agnocast_proc *notifier;
+	struct timer_list watchdog;
 	/* Callback subscribers: queued when the process dies (ns->lock). */
 	struct agnocast_exit_record_node *exit_record;
 };
@@ -360,6 +372,33 @@ void agnocast_pool_describe(struct agnocast_mempool *pool, struct agnocast_pool 
 void agnocast_pool_mark_given(struct agnocast_proc *proc, const struct agnocast_pool *granted,
 			      struct file *file);
 void agnocast_pool_drop_given(struct agnocast_proc *proc);
+
+/* agnocast_wake.c: the promise a PUBLISH's listing makes, and breaking it. */
+#define AGNOCAST_WAKE_WATCHDOG_JIFFIES msecs_to_jiffies(AGNOCAST_WAKE_WATCHDOG_MS)
+void agnocast_wake_break(struct agnocast_subscriber *sub);
+void agnocast_wake_sub_init(struct agnocast_subscriber *sub);
+void agnocast_wake_sub_shutdown(struct agnocast_subscriber *sub);
+void agnocast_wake_publisher_gone(struct agnocast_proc *proc);
+void agnocast_wake_set_eventfd(struct agnocast_proc *proc, struct eventfd_ctx *wake);
+void agnocast_wake_put_eventfd(struct agnocast_proc *proc);
+
+/*
+ * A PUBLISH by @notifier lists @sub (topic->lock held): the watchdog checks
+ * that it looks within AGNOCAST_WAKE_WATCHDOG_MS of the first listing since
+ * it last looked.  Arming costs a timer update at most once per period.
+ */
+static inline void agnocast_wake_promise(struct agnocast_subscriber *sub,
+					 struct agnocast_proc *notifier)
+{
+	if (!sub->notified) {
+		WRITE_ONCE(sub->notified_at, jiffies);
+		WRITE_ONCE(sub->notified, true);
+	}
+	sub->notifier = notifier;
+	/* The unit tests' subscribers have no watchdog. */
+	if (sub->watchdog.function && !timer_pending(&sub->watchdog))
+		mod_timer(&sub->watchdog, sub->notified_at + AGNOCAST_WAKE_WATCHDOG_JIFFIES);
+}
 
 /* agnocast_entry.c: the entry engine; no user copies, topic->lock held. */
 int agnocast_entry_init(void);
@@ -567,6 +606,7 @@ int agnocast_add_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_remove_publisher(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_remove_subscriber(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg);
+int agnocast_notify_failed(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_receive(struct agnocast_ns *file_ns, void __user *uarg);
 int agnocast_take(struct agnocast_ns *file_ns, void __user *uarg);

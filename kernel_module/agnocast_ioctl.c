@@ -246,6 +246,44 @@ out_leave:
 	return ret;
 }
 
+int agnocast_notify_failed(struct agnocast_ns *file_ns, void __user *uarg)
+{
+	struct agnocast_notify_failed arg;
+	struct agnocast_subscriber *sub;
+	struct agnocast_endpoint *ep;
+	struct agnocast_topic *topic;
+	struct agnocast_ctx ctx;
+	int ret;
+
+	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
+		return -EFAULT;
+	if (arg.reserved)
+		return -EINVAL;
+	ret = agnocast_enter_read(&ctx, file_ns);
+	if (ret)
+		return ret;
+	ret = agnocast_endpoint_lookup(ctx.ns, ctx.proc, arg.topic_handle, arg.publisher_id,
+				       true, &ep);
+	if (ret)
+		goto out_leave;
+	topic = ep->topic;
+	/* Endpoints come and go under the namespace lock held for write. */
+	ep = xa_load(&topic->endpoints, arg.subscriber_id);
+	ret = -ENOENT;
+	if (!ep || ep->publisher)
+		goto out_leave;
+	sub = agnocast_to_subscriber(ep);
+	ret = 0;
+	mutex_lock(&topic->lock);
+	/* A subscriber that looked since needs nothing: it got the entries. */
+	if (sub->notified)
+		agnocast_wake_break(sub);
+	mutex_unlock(&topic->lock);
+out_leave:
+	agnocast_leave(&ctx);
+	return ret;
+}
+
 int agnocast_reclaim(struct agnocast_ns *file_ns, void __user *uarg)
 {
 	struct agnocast_reclaim __user *ureclaim = uarg;

@@ -145,6 +145,8 @@ static long agnocast_ioctl(struct file *file, unsigned int cmd, unsigned long ar
 		return agnocast_get_policy(ns, uarg);
 	case AGNOCAST_IOC_TOPIC_SCHEMA:
 		return agnocast_topic_schema(ns, uarg);
+	case AGNOCAST_IOC_NOTIFY_FAILED:
+		return agnocast_notify_failed(ns, uarg);
 	default:
 		return -ENOTTY;
 	}

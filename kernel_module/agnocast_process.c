@@ -91,7 +91,9 @@ static void agnocast_proc_teardown(struct agnocast_proc *proc, bool record)
 
 	if (record)
 		agnocast_queue_exit_records(proc);
+	agnocast_wake_publisher_gone(proc);
 	agnocast_proc_drop_endpoints(proc);
+	agnocast_wake_put_eventfd(proc);
 	agnocast_proc_drop_reclaim(proc);
 	agnocast_pool_drop_given(proc);
 	agnocast_pool_orphan(ns, proc->pool);

@@ -282,6 +282,7 @@ static void agnocast_endpoint_free(struct agnocast_endpoint *ep)
 		return;
 	}
 	sub = agnocast_to_subscriber(ep);
+	agnocast_wake_sub_shutdown(sub);
 	agnocast_exit_record_free(sub->exit_record);
 	kvfree(sub->unreceived);
 	kvfree(sub->held);
@@ -313,6 +314,7 @@ struct agnocast_endpoint *agnocast_endpoint_create(struct agnocast_topic *topic,
 		sub = kzalloc(sizeof(*sub), GFP_KERNEL_ACCOUNT);
 		if (!sub)
 			return NULL;
+		agnocast_wake_sub_init(sub);
 		ep = &sub->ep;
 		sub->unreceived = kvmalloc_array(arg->depth, sizeof(*sub->unreceived),
 						 GFP_KERNEL_ACCOUNT);

@@ -1352,10 +1352,15 @@ TEST_F(Device, ReceiveIntoABufferEndingReadOnlyReceivesNothing) {
 TEST_F(Device, RequestFlagsAndReservedMustBeZero) {
   auto r = poisoned_request<agnocast_register_process>();
   r.pool_fd = -1;
-  r.flags = 1;
+  r.flags = 1u << 31;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
   r.flags = 0;
-  r.reserved = 1;
+  r.wake_fd = 1;  // a wake_fd without its flag
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
+  r.flags = AGNOCAST_REGISTER_WAKE_EVENTFD;
+  r.wake_fd = -1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EBADF);
+  r.wake_fd = dev;  // open, but no eventfd
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EINVAL);
   EXPECT_FALSE(process_listed(dev, getpid()));
 

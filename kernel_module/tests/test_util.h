@@ -38,13 +38,17 @@ T poisoned()
   return value;
 }
 
-// Poisoned but for flags and reserved, which a request must leave zero.
+// Poisoned but for flags and reserved (or REGISTER_PROCESS's wake_fd),
+// which a request must leave zero.
 template <class T>
 T poisoned_request()
 {
   T value = poisoned<T>();
   value.flags = 0;
-  value.reserved = 0;
+  if constexpr (requires { value.reserved; })
+    value.reserved = 0;
+  else
+    value.wake_fd = 0;
   return value;
 }
 

@@ -2,6 +2,7 @@
 
 #include <agnocast.h>
 #include <fcntl.h>
+#include <sys/eventfd.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -18,6 +19,7 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/inspect.hpp"
 #include "agnocast/limits.hpp"
+#include "log_internal.hpp"
 
 namespace agnocast {
 
@@ -273,12 +275,14 @@ Device Device::open(bool nonblocking) {
   return Device(fd);
 }
 
-Device::Device(Device&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+Device::Device(Device&& other) noexcept
+    : fd_(std::exchange(other.fd_, -1)), wake_fd_(std::exchange(other.wake_fd_, -1)) {}
 
 Device& Device::operator=(Device&& other) noexcept {
   if (this != &other) {
     close();
     fd_ = std::exchange(other.fd_, -1);
+    wake_fd_ = std::exchange(other.wake_fd_, -1);
   }
   return *this;
 }
@@ -287,6 +291,7 @@ Device::~Device() { close(); }
 
 void Device::close() noexcept {
   if (fd_ >= 0) ::close(std::exchange(fd_, -1));
+  if (wake_fd_ >= 0) ::close(std::exchange(wake_fd_, -1));
 }
 
 Version Device::get_version() const {
@@ -295,9 +300,17 @@ Version Device::get_version() const {
   return Version{argument.major, argument.minor, argument.patch};
 }
 
-PoolSlot Device::register_process(int pool_fd) const {
+PoolSlot Device::register_process(int pool_fd) {
   agnocast_register_process argument{};
   argument.pool_fd = pool_fd;
+  if (pool_fd == -1 && wake_fd_ < 0) {
+    wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+    if (wake_fd_ < 0) fail("eventfd for the wake-up's safety net", errno);
+  }
+  if (pool_fd == -1) {
+    argument.flags = AGNOCAST_REGISTER_WAKE_EVENTFD;
+    argument.wake_fd = wake_fd_;
+  }
   if (int err = call(fd_, AGNOCAST_IOC_REGISTER_PROCESS, &argument)) {
     switch (err) {
       case ENOSPC:
@@ -350,6 +363,17 @@ void Device::remove_subscriber(EndpointId endpoint) {
   agnocast_remove_endpoint argument{endpoint.topic_handle, endpoint.id};
   if (int err = call(fd_, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &argument)) {
     fail("REMOVE_SUBSCRIBER", err);
+  }
+}
+
+void Device::notify_failed(EndpointId publisher, std::uint32_t subscriber_id) noexcept {
+  agnocast_notify_failed argument{};
+  argument.topic_handle = publisher.topic_handle;
+  argument.publisher_id = publisher.id;
+  argument.subscriber_id = subscriber_id;
+  // ENOENT: the subscriber is gone, and nothing waits for it.
+  if (int err = call(fd_, AGNOCAST_IOC_NOTIFY_FAILED, &argument); err && err != ENOENT) {
+    log(LogLevel::warning, std::string("agnocast: NOTIFY_FAILED: ") + std::strerror(err));
   }
 }
 

@@ -51,8 +51,9 @@ class Device final : public Kernel {
   int release() { return std::exchange(fd_, -1); }
 
   Version get_version() const;
-  // pool_fd -1 reserves a slot; a memfd of the slot's size attaches it.
-  PoolSlot register_process(int pool_fd) const;
+  // pool_fd -1 reserves a slot, and gives the module the wake eventfd,
+  // created here; a memfd of the slot's size attaches it.
+  PoolSlot register_process(int pool_fd);
   void unregister_process() const;
 
   EndpointId add_publisher(const EndpointRequest& request) override;
@@ -62,6 +63,8 @@ class Device final : public Kernel {
   PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
                         std::span<std::uint32_t> wake_ids,
                         std::span<std::uint64_t> reclaim) override;
+  void notify_failed(EndpointId publisher, std::uint32_t subscriber_id) noexcept override;
+  int wake_fd() const override { return wake_fd_; }
   ReclaimResult reclaim(std::span<std::uint64_t> reclaim) override;
   std::uint32_t shed() override;
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
@@ -88,6 +91,7 @@ class Device final : public Kernel {
 
  private:
   int fd_ = -1;
+  int wake_fd_ = -1;
 };
 
 }  // namespace agnocast::detail

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -21,6 +22,8 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/signals.hpp"
 #include "node_state.hpp"
+#include "notification_queue.hpp"
+#include "runtime.hpp"
 #include "signals_internal.hpp"
 
 namespace agnocast {
@@ -30,6 +33,7 @@ namespace {
 constexpr std::uint64_t shutdown_key = ~std::uint64_t{0};
 constexpr std::uint64_t cancel_key = shutdown_key - 1;
 constexpr std::uint64_t change_key = shutdown_key - 2;
+constexpr std::uint64_t wake_key = shutdown_key - 3;
 
 int make_eventfd() {
   const int fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
@@ -95,6 +99,15 @@ struct Executor::State {
   void sync() {
     std::lock_guard lock(mutex);
     drain_eventfd(change_fd);
+    // The kernel's word that a notification may have been lost, once the
+    // process has a runtime (its nodes make it).
+    if (watched_wake_fd < 0) {
+      const detail::Runtime* runtime = detail::Runtime::current();
+      if (const int fd = runtime ? runtime->wake_fd() : -1; fd >= 0) {
+        watch(epoll_fd, fd, wake_key, EPOLLIN, EPOLL_CTL_ADD);
+        watched_wake_fd = fd;
+      }
+    }
     std::erase_if(armed, [](const auto& entry) { return entry.second.expired(); });
     std::erase_if(timed, [](const auto& weak) { return weak.expired(); });
     for (const auto& node : nodes) {
@@ -150,6 +163,15 @@ struct Executor::State {
       sync();
       return Outcome::idle;
     }
+    if (key == wake_key) {
+      // Another executor of this process may have taken it first: it wakes
+      // every queue of the process, ours too.
+      std::uint64_t signals = 0;
+      if (::read(watched_wake_fd, &signals, sizeof signals) == sizeof signals) {
+        detail::OwnedQueue::wake_all();
+      }
+      return Outcome::idle;
+    }
     std::shared_ptr<detail::Waitable> waitable = find(key);
     if (!waitable) return Outcome::idle;
     const bool housekeeping = waitable->housekeeping();
@@ -192,7 +214,8 @@ struct Executor::State {
   const int epoll_fd;
   const int cancel_fd;
   const int change_fd;
-  std::mutex mutex;  // nodes, armed and fds
+  std::atomic<int> watched_wake_fd{-1};  // the runtime's, not ours to close
+  std::mutex mutex;  // nodes, armed, fds and watched_wake_fd
   std::vector<std::shared_ptr<detail::NodeState>> nodes;
   std::map<std::uint64_t, std::weak_ptr<detail::Waitable>> armed;
   std::map<int, std::shared_ptr<FdWaitable>> fds;  // what add_fd() added, by descriptor

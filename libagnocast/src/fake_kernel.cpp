@@ -1,5 +1,6 @@
 #include "fake_kernel.hpp"
 
+#include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,6 +19,93 @@ namespace {
 }  // namespace
 
 FakeKernel::FakeKernel() : caller_pid_(::getpid()) {}
+
+FakeKernel::~FakeKernel() {
+  for (const auto& [pid, fd] : wake_fds_) ::close(fd);
+}
+
+int FakeKernel::wake_fd() const {
+  std::lock_guard lock(mutex_);
+  auto found = wake_fds_.find(caller_pid_);
+  if (found == wake_fds_.end()) {
+    const int fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+    if (fd < 0) fail("eventfd", errno);
+    found = wake_fds_.emplace(caller_pid_, fd).first;
+  }
+  return found->second;
+}
+
+void FakeKernel::promise(Subscriber& subscriber) {
+  if (!subscriber.notified) {
+    subscriber.notified = true;
+    subscriber.notified_at = std::chrono::steady_clock::now();
+  }
+  subscriber.notifier = caller_pid_;
+}
+
+void FakeKernel::break_promise(Subscriber& subscriber) {
+  subscriber.notified = false;
+  if (const auto found = wake_fds_.find(subscriber.pid); found != wake_fds_.end()) {
+    const std::uint64_t one = 1;
+    [[maybe_unused]] const ssize_t written = ::write(found->second, &one, sizeof one);
+  }
+}
+
+void FakeKernel::break_overdue_promises() {
+  const auto now = std::chrono::steady_clock::now();
+  for (auto& [handle, topic] : topics_) {
+    for (auto& [id, subscriber] : topic.subscribers) {
+      if (subscriber.notified && now - subscriber.notified_at >= watchdog_period) {
+        break_promise(subscriber);
+      }
+    }
+  }
+}
+
+void FakeKernel::run_watchdog() {
+  std::lock_guard lock(mutex_);
+  break_overdue_promises();
+}
+
+void FakeKernel::notify_failed(EndpointId publisher, std::uint32_t subscriber_id) noexcept {
+  std::lock_guard lock(mutex_);
+  break_overdue_promises();
+  const auto topic = topics_.find(publisher.topic_handle);
+  if (topic == topics_.end()) return;
+  const auto pub = topic->second.publishers.find(publisher.id);
+  if (pub == topic->second.publishers.end() || pub->second.pid != caller_pid_) return;
+  const auto sub = topic->second.subscribers.find(subscriber_id);
+  // One that looked since got the entries.
+  if (sub != topic->second.subscribers.end() && sub->second.notified) break_promise(sub->second);
+}
+
+void FakeKernel::end_process(pid_t pid) {
+  std::lock_guard lock(mutex_);
+  for (auto& [handle, topic] : topics_) {
+    const bool published = std::any_of(topic.publishers.begin(), topic.publishers.end(),
+                                       [&](const auto& entry) { return entry.second.pid == pid; });
+    if (!published) continue;
+    for (auto& [id, subscriber] : topic.subscribers) {
+      if (subscriber.notified && subscriber.notifier == pid) break_promise(subscriber);
+    }
+  }
+  for (auto& [handle, topic] : topics_) {
+    std::vector<std::uint32_t> subscribers, publishers;
+    for (const auto& [id, subscriber] : topic.subscribers) {
+      if (subscriber.pid == pid) subscribers.push_back(id);
+    }
+    for (const auto& [id, publisher] : topic.publishers) {
+      if (publisher.pid == pid) publishers.push_back(id);
+    }
+    for (const std::uint32_t id : subscribers) remove_subscriber_locked(topic, id);
+    for (const std::uint32_t id : publishers) remove_publisher_locked(topic, id);
+  }
+  reclaimable_.erase(pid);
+  if (const auto found = wake_fds_.find(pid); found != wake_fds_.end()) {
+    ::close(found->second);
+    wake_fds_.erase(found);
+  }
+}
 
 std::uint32_t FakeKernel::join(const EndpointRequest& request) {
   for (const auto& [handle, topic] : topics_) {
@@ -96,8 +184,12 @@ EndpointId FakeKernel::add_subscriber(const EndpointRequest& request) {
 void FakeKernel::remove_publisher(EndpointId endpoint) {
   std::lock_guard lock(mutex_);
   Topic& topic = topic_of(endpoint);
-  const auto found = topic.publishers.find(endpoint.id);
-  if (found == topic.publishers.end()) fail("REMOVE_PUBLISHER", ENOENT);
+  if (!topic.publishers.contains(endpoint.id)) fail("REMOVE_PUBLISHER", ENOENT);
+  remove_publisher_locked(topic, endpoint.id);
+}
+
+void FakeKernel::remove_publisher_locked(Topic& topic, std::uint32_t id) {
+  const auto found = topic.publishers.find(id);
   const std::deque<std::uint64_t> window = std::move(found->second.window);
   topic.publishers.erase(found);
   for (std::uint64_t entry_id : window) {
@@ -108,10 +200,15 @@ void FakeKernel::remove_publisher(EndpointId endpoint) {
 
 void FakeKernel::remove_subscriber(EndpointId endpoint) {
   std::lock_guard lock(mutex_);
-  Subscriber& subscriber = subscriber_of(endpoint);
+  subscriber_of(endpoint);  // checks that it is the caller's
+  remove_subscriber_locked(topic_of(endpoint), endpoint.id);
+}
+
+void FakeKernel::remove_subscriber_locked(Topic& topic, std::uint32_t id) {
+  Subscriber& subscriber = topic.subscribers.at(id);
   const std::deque<std::uint64_t> unreceived = std::move(subscriber.unreceived);
   const std::multiset<std::uint64_t> held = std::move(subscriber.held);
-  topic_of(endpoint).subscribers.erase(endpoint.id);
+  topic.subscribers.erase(id);
   for (std::uint64_t entry_id : unreceived) {
     --entries_[entry_id].unreceived_by;
     settle(entry_id);
@@ -140,6 +237,7 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
                                   std::span<std::uint32_t> wake_ids,
                                   std::span<std::uint64_t> reclaim) {
   std::lock_guard lock(mutex_);
+  break_overdue_promises();
   ++calls_.publish;
   Topic& topic = topic_of(publisher_id);
   const auto found = topic.publishers.find(publisher_id.id);
@@ -163,7 +261,7 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
       drop_unreceived(subscriber, oldest);
     }
     if (subscriber.polling || (subscriber.wake_once && subscriber.notified)) continue;
-    subscriber.notified = true;
+    promise(subscriber);
     wake_ids[result.wake_count++] = id;
   }
   publisher.window.push_back(entry_id);
@@ -223,10 +321,12 @@ ReceiveResult FakeKernel::receive(EndpointId subscriber_id, std::span<ReceivedEn
   std::lock_guard lock(mutex_);
   ++calls_.receive;
   if (entries.empty() || pools.empty() || release_ids.size() > release_max) fail("RECEIVE", EINVAL);
+  break_overdue_promises();
   Subscriber& subscriber = subscriber_of(subscriber_id);
   if (subscriber.polling) fail("RECEIVE", EINVAL);
-  release_held("RECEIVE", subscriber, release_ids);
+  // It looks whatever the answer, as in the module.
   subscriber.notified = false;
+  release_held("RECEIVE", subscriber, release_ids);
   ReceiveResult result;
   const std::size_t capacity = std::min(entries.size(), receive_entries_max);
   while (result.entry_count < capacity && !subscriber.unreceived.empty()) {

@@ -6,6 +6,7 @@
 
 #include <sys/types.h>
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -21,6 +22,9 @@ namespace agnocast::detail {
 class FakeKernel final : public Kernel {
  public:
   FakeKernel();
+  ~FakeKernel() override;
+  FakeKernel(const FakeKernel&) = delete;
+  FakeKernel& operator=(const FakeKernel&) = delete;
 
   // How often each call was made, for tests of the library's loops.
   struct Calls {
@@ -41,6 +45,9 @@ class FakeKernel final : public Kernel {
   PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
                         std::span<std::uint32_t> wake_ids,
                         std::span<std::uint64_t> reclaim) override;
+  void notify_failed(EndpointId publisher, std::uint32_t subscriber_id) noexcept override;
+  // The caller process's wake eventfd, made on first use.
+  int wake_fd() const override;
   ReclaimResult reclaim(std::span<std::uint64_t> reclaim) override;
   std::uint32_t shed() override;
   ReceiveResult receive(EndpointId subscriber, std::span<ReceivedEntry> entries,
@@ -58,6 +65,13 @@ class FakeKernel final : public Kernel {
   void set_caller_pid(pid_t pid);
   // From now on release() fails with err (0: succeeds again).
   void fail_releases(int err);
+  // The process dies, as the module's teardown sees it: the promises it made
+  // break, then its endpoints go.
+  void end_process(pid_t pid);
+  // What the module's watchdog does on its own: breaks the promises not kept
+  // within the watchdog period (AGNOCAST_WAKE_WATCHDOG_MS). Every call runs it too.
+  void run_watchdog();
+  static constexpr std::chrono::milliseconds watchdog_period{50};
 
  private:
   struct Entry {
@@ -85,7 +99,11 @@ class FakeKernel final : public Kernel {
     bool polling = false;
     bool ignore_local = false;
     bool wake_once = false;
-    bool notified = false;  // wake_once: listed in a wake set since its last receive
+    // Listed in a wake set since its last receive (a wake_once one is listed
+    // again only when false), when first, and by which process.
+    bool notified = false;
+    std::chrono::steady_clock::time_point notified_at;
+    pid_t notifier = 0;
     std::deque<std::uint64_t> unreceived;
     std::multiset<std::uint64_t> held;
     std::uint64_t received = 0;
@@ -103,6 +121,12 @@ class FakeKernel final : public Kernel {
   // The handle of the request's topic, created when new; checks the type.
   std::uint32_t join(const EndpointRequest& request);
   Subscriber& subscriber_of(EndpointId endpoint);
+  // The module's wake rules (kernel_module/agnocast_wake.c), mutex_ held.
+  void promise(Subscriber& subscriber);
+  void break_promise(Subscriber& subscriber);
+  void break_overdue_promises();
+  void remove_subscriber_locked(Topic& topic, std::uint32_t id);
+  void remove_publisher_locked(Topic& topic, std::uint32_t id);
   // Drops one reference kind of an entry; an unreferenced entry becomes reclaimable.
   void settle(std::uint64_t entry_id);
   void drop_unreceived(Subscriber& subscriber, std::uint64_t entry_id);
@@ -120,6 +144,7 @@ class FakeKernel final : public Kernel {
   std::map<pid_t, std::deque<std::uint64_t>> reclaimable_;  // addresses per owning process
   Calls calls_;
   int release_error_ = 0;
+  mutable std::map<pid_t, int> wake_fds_;
 };
 
 }  // namespace agnocast::detail

@@ -84,6 +84,14 @@ class Kernel {
   virtual PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
                                 std::span<std::uint32_t> wake_ids,
                                 std::span<std::uint64_t> reclaim) = 0;
+  // The publisher could not send the notification publish() listed
+  // subscriber_id for: the kernel wakes the subscriber's process through its
+  // wake_fd() and lists it again at the next publish(). Never throws.
+  virtual void notify_failed(EndpointId publisher, std::uint32_t subscriber_id) noexcept = 0;
+  // Readable (an eventfd) when a notification to one of this process's
+  // callback subscribers may have been lost: each of them should then
+  // receive (OwnedQueue::wake_all()). -1 when there is none.
+  virtual int wake_fd() const = 0;
   virtual ReclaimResult reclaim(std::span<std::uint64_t> reclaim) = 0;
   // Drops entries of this process's pool kept only for slow subscribers beyond
   // the publisher's depth; returns how many. Reclaim afterwards.

@@ -8,6 +8,8 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <set>
 
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
@@ -20,6 +22,13 @@ constexpr std::size_t max_cached_senders = 256;
 // Publishers of every user may wake us (a spurious wake-up only costs a
 // RECEIVE that finds nothing); nobody but us may take our wake-ups.
 constexpr mode_t queue_mode = 0622;
+
+// The queues this process owns, for OwnedQueue::wake_all().
+std::mutex owned_mutex;
+std::set<const OwnedQueue*>& owned_queues() {
+  static auto* queues = new std::set<const OwnedQueue*>;  // outlives static destructors
+  return *queues;
+}
 
 std::string creation_advice(int err) {
   switch (err) {
@@ -60,7 +69,9 @@ OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
   attributes.mq_maxmsg = std::min(std::max(static_cast<long>(depth), 2L), system_msg_max());
   capacity_ = attributes.mq_maxmsg;
   attributes.mq_msgsize = sizeof(MqMsgAgnocast);
-  const int flags = O_RDONLY | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
+  // Read-write: only the creator may open it so (mode 0622), and sending to
+  // itself then needs no other descriptor.
+  const int flags = O_RDWR | O_NONBLOCK | O_CREAT | O_EXCL | O_CLOEXEC;
   descriptor_ = ::mq_open(name.c_str(), flags, queue_mode, &attributes);
   if (descriptor_ == -1 && errno == EEXIST) {
     // The kernel never gives a live subscriber's id twice for a name, so this
@@ -81,9 +92,15 @@ OwnedQueue::OwnedQueue(const std::string& name, std::size_t depth)
     throw QueueError(err, "agnocast: cannot set the mode of notification queue " + name + " (" +
                               std::strerror(err) + ")");
   }
+  std::lock_guard lock(owned_mutex);
+  owned_queues().insert(this);
 }
 
 OwnedQueue::~OwnedQueue() {
+  {
+    std::lock_guard lock(owned_mutex);
+    owned_queues().erase(this);
+  }
   ::mq_close(descriptor_);
   // A fork child shares the descriptor but not the ownership.
   if (::getpid() == owner_pid_) ::mq_unlink(name_.c_str());
@@ -98,31 +115,39 @@ bool OwnedQueue::take_one() const {
 }
 
 void OwnedQueue::notify() const {
-  // Our own descriptor is read-only, as the seed prescribes: send through another.
-  const mqd_t sender = ::mq_open(name_.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
-  if (sender == -1) return;
   const MqMsgAgnocast message{};
-  ::mq_send(sender, reinterpret_cast<const char*>(&message), sizeof message, 0);
-  ::mq_close(sender);
+  while (::mq_send(descriptor_, reinterpret_cast<const char*>(&message), sizeof message, 0) != 0 &&
+         errno == EINTR) {
+  }
+}
+
+void OwnedQueue::wake_all() {
+  const pid_t pid = ::getpid();
+  std::lock_guard lock(owned_mutex);
+  for (const OwnedQueue* queue : owned_queues()) {
+    // A fork child's copies are its parent's to wake.
+    if (queue->owner_pid_ == pid) queue->notify();
+  }
 }
 
 QueueSenders::~QueueSenders() {
   for (const auto& [id, descriptor] : descriptors_) ::mq_close(descriptor);
 }
 
-void QueueSenders::notify(std::uint32_t subscriber_id) {
+bool QueueSenders::notify(std::uint32_t subscriber_id) {
   auto found = descriptors_.find(subscriber_id);
   if (found == descriptors_.end()) {
     const mqd_t descriptor =
         ::mq_open(queue_name(topic_, subscriber_id).c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
     if (descriptor == -1) {
-      // Not created yet (ENOENT): the subscriber wakes itself once it has made its queue.
+      // ENOENT: not created yet (the subscriber wakes itself once it has
+      // made it), or removed under a live subscriber.
       if (errno != ENOENT) {
         log(LogLevel::warning, "cannot open the notification queue " +
                                    queue_name(topic_, subscriber_id) +
                                    " to wake its subscriber: " + std::strerror(errno));
       }
-      return;
+      return false;
     }
     // Ids of gone subscribers are never reused, so the cache only grows; bound it.
     if (descriptors_.size() >= max_cached_senders) {
@@ -134,15 +159,17 @@ void QueueSenders::notify(std::uint32_t subscriber_id) {
   const MqMsgAgnocast message{};
   for (;;) {
     if (::mq_send(found->second, reinterpret_cast<const char*>(&message), sizeof message, 0) == 0) {
-      return;
+      return true;
     }
     if (errno == EINTR) continue;
     // Full: a wake-up is already waiting, which is all a notification says.
-    if (errno != EAGAIN) {
-      log(LogLevel::warning,
-          "cannot notify " + queue_name(topic_, subscriber_id) + ": " + std::strerror(errno));
-    }
-    return;
+    if (errno == EAGAIN) return true;
+    log(LogLevel::warning,
+        "cannot notify " + queue_name(topic_, subscriber_id) + ": " + std::strerror(errno));
+    // Opened afresh next time.
+    ::mq_close(found->second);
+    descriptors_.erase(found);
+    return false;
   }
 }
 

@@ -11,7 +11,9 @@
 
 namespace agnocast::detail {
 
-// The receiving end a callback subscriber creates and owns; unlinked on destruction.
+// The receiving end a callback subscriber creates and owns; unlinked on
+// destruction. It also sends to itself, through its own descriptor, so that
+// waking itself needs no descriptor more (the process may have none left).
 class OwnedQueue {
  public:
   // Creates name for depth notifications (two at least, capped by
@@ -32,6 +34,10 @@ class OwnedQueue {
   bool drains_after() const { return capacity_ >= 2; }
   // Queues one notification to ourselves (never blocks; a full queue is fine).
   void notify() const;
+  // Notifies every queue this process owns: the kernel's wake_fd() said a
+  // notification to one of them may have been lost. A wake-up that finds
+  // nothing costs one RECEIVE.
+  static void wake_all();
 
  private:
   std::string name_;
@@ -48,9 +54,11 @@ class QueueSenders {
   QueueSenders(const QueueSenders&) = delete;
   QueueSenders& operator=(const QueueSenders&) = delete;
 
-  // Never blocks and never throws: a full queue already holds a wake-up, and a
-  // queue not created yet is notified by its subscriber itself.
-  void notify(std::uint32_t subscriber_id);
+  // Never blocks and never throws. True when the subscriber has a wake-up
+  // waiting: sent now, or already there (a full queue). False when the queue
+  // could not be opened or the send failed: the caller reports it to the
+  // kernel (Kernel::notify_failed), which wakes the subscriber another way.
+  bool notify(std::uint32_t subscriber_id);
 
  private:
   std::string topic_;

@@ -109,7 +109,11 @@ void PublisherCore::publish(void* message, std::size_t bytes) {
         throw;
       }
     }
-    for (std::uint32_t i = 0; i < result.wake_count; ++i) state.senders.notify(state.wake_ids[i]);
+    for (std::uint32_t i = 0; i < result.wake_count; ++i) {
+      if (!state.senders.notify(state.wake_ids[i])) {
+        state.runtime.kernel().notify_failed(state.endpoint, state.wake_ids[i]);
+      }
+    }
   }
   // Freed at the next borrow: the subscribers run first.
   state.runtime.defer_free(std::span(reclaimed.data(), result.reclaim_count));

@@ -32,6 +32,8 @@ class Runtime {
                                       std::unique_ptr<Kernel> kernel = nullptr);
 
   Kernel& kernel() const { return *kernel_; }
+  // The kernel's wake_fd() (-1 without a kernel): every executor watches it.
+  int wake_fd() const { return kernel_ ? kernel_->wake_fd() : -1; }
   pid_t pid() const { return pid_; }
 
   // Throws PoolExhausted after a reclaim round could not make room.

@@ -45,7 +45,7 @@
 
 /* The module and the library must agree on major and minor. */
 #define AGNOCAST_VERSION_MAJOR 0
-#define AGNOCAST_VERSION_MINOR 3
+#define AGNOCAST_VERSION_MINOR 4
 #define AGNOCAST_VERSION_PATCH 0
 
 /* Including the terminating NUL. */
@@ -79,8 +79,19 @@
  * woke it before or after): every entry published after that RECEIVE looked
  * wakes it again.  A notification sent to a full queue may be dropped: one
  * is waiting.
+ *
+ * A listing is a promise that the publisher's process keeps by sending the
+ * notification.  When it may not have been kept, the subscriber is listed
+ * again by the next PUBLISH and its process's wake eventfd (REGISTER_PROCESS)
+ * is signalled at once: when the publisher's process dies while the
+ * subscriber has not looked since, when the publisher reports that it could
+ * not notify (NOTIFY_FAILED), and when the subscriber has not looked within
+ * AGNOCAST_WAKE_WATCHDOG_MS of being listed, whatever the cause (a stopped
+ * publisher, a queue replaced under its name).  The same holds for callback
+ * subscribers without the flag, which are listed by every PUBLISH.
  */
 #define AGNOCAST_WAKE_ONCE (1U << 4)
+#define AGNOCAST_WAKE_WATCHDOG_MS 50
 
 /*
  * AGNOCAST_IOC_GET_VERSION: never fails but for -EFAULT.
@@ -113,18 +124,30 @@ struct agnocast_version {
  *            pool_size
  *   -EPERM   pool_fd lacks one of AGNOCAST_POOL_SEALS (F_SEAL_WRITE is
  *            accepted in place of F_SEAL_FUTURE_WRITE)
+ *
+ * With AGNOCAST_REGISTER_WAKE_EVENTFD in flags, either step also sets the
+ * process's wake eventfd to wake_fd (replacing one set before): the module
+ * signals it when a notification to one of the process's callback
+ * subscribers may have been lost (AGNOCAST_WAKE_ONCE), and the process
+ * should then make each of them RECEIVE.  Without the flag wake_fd must be
+ * 0.
+ *
+ *   -EBADF   wake_fd is not an open descriptor
+ *   -EINVAL  wake_fd is not an eventfd
  */
 #define AGNOCAST_POOL_SEALS \
 	(0x0002 /* F_SEAL_SHRINK */ | 0x0004 /* F_SEAL_GROW */ | \
 	 0x0010 /* F_SEAL_FUTURE_WRITE */ | 0x0001 /* F_SEAL_SEAL */)
+
+#define AGNOCAST_REGISTER_WAKE_EVENTFD (1U << 0)
 
 struct agnocast_register_process {
 	__s32 pool_fd;
 	__s32 pid;
 	__u64 pool_addr;
 	__u64 pool_size;
-	__u32 flags;		/* none defined: must be 0 */
-	__u32 reserved;
+	__u32 flags;		/* AGNOCAST_REGISTER_WAKE_EVENTFD or 0 */
+	__s32 wake_fd;
 };
 
 /*
@@ -555,6 +578,27 @@ struct agnocast_list_processes {
 	__u32 reserved;
 };
 
+/*
+ * AGNOCAST_IOC_NOTIFY_FAILED: the caller's publisher publisher_id of the
+ * topic topic_handle could not send the notification a PUBLISH listed
+ * subscriber_id for (its queue could not be opened, or the send failed other
+ * than for a full queue).  Unless the subscriber has looked since, it is
+ * listed again by the next PUBLISH and its process's wake eventfd is
+ * signalled (AGNOCAST_WAKE_ONCE).
+ *
+ *   -ENOENT  no such publisher, or the subscriber is gone (nothing waits
+ *            for it)
+ *   -EPERM   the publisher is another process's
+ *   -ESRCH   the caller is not registered
+ *   -EINVAL  reserved is not 0
+ */
+struct agnocast_notify_failed {
+	__u32 topic_handle;
+	__u32 publisher_id;
+	__u32 subscriber_id;
+	__u32 reserved;
+};
+
 #define AGNOCAST_IOC_MAGIC 0xAC
 
 #define AGNOCAST_IOC_GET_VERSION _IOR(AGNOCAST_IOC_MAGIC, 0, struct agnocast_version)
@@ -579,6 +623,7 @@ struct agnocast_list_processes {
 #define AGNOCAST_IOC_SET_POLICY _IOW(AGNOCAST_IOC_MAGIC, 16, struct agnocast_policy)
 #define AGNOCAST_IOC_GET_POLICY _IOWR(AGNOCAST_IOC_MAGIC, 17, struct agnocast_policy)
 #define AGNOCAST_IOC_TOPIC_SCHEMA _IOWR(AGNOCAST_IOC_MAGIC, 18, struct agnocast_topic_schema)
+#define AGNOCAST_IOC_NOTIFY_FAILED _IOW(AGNOCAST_IOC_MAGIC, 19, struct agnocast_notify_failed)
 
 /*
  * Exit records: read() on /dev/agnocast returns whole records, oldest first,

@@ -385,16 +385,17 @@ void agnocast_wake_put_eventfd(struct agnocast_proc *proc);
 /*
  * A PUBLISH by @notifier lists @sub (topic->lock held): the watchdog checks
  * that it looks within AGNOCAST_WAKE_WATCHDOG_MS of the first listing since
- * it last looked.  Arming costs a timer update at most once per period.
+ * it last looked.  Arming costs a timer update at most once per wake-up,
+ * none while the timer of an earlier one is still pending.
  */
 static inline void agnocast_wake_promise(struct agnocast_subscriber *sub,
 					 struct agnocast_proc *notifier)
 {
-	if (!sub->notified) {
-		WRITE_ONCE(sub->notified_at, jiffies);
-		WRITE_ONCE(sub->notified, true);
-	}
 	sub->notifier = notifier;
+	if (sub->notified)
+		return;
+	WRITE_ONCE(sub->notified_at, jiffies);
+	WRITE_ONCE(sub->notified, true);
 	/* The unit tests' subscribers have no watchdog. */
 	if (sub->watchdog.function && !timer_pending(&sub->watchdog))
 		mod_timer(&sub->watchdog, sub->notified_at + AGNOCAST_WAKE_WATCHDOG_JIFFIES);

@@ -12,9 +12,12 @@
  *   - when the publisher's process dies before the subscriber looked: it
  *     may have died before sending;
  *   - when the publisher reports it could not send (NOTIFY_FAILED);
- *   - when the subscriber has not looked AGNOCAST_WAKE_WATCHDOG_MS after
- *     the listing, whatever the cause (a stopped publisher, a notification
- *     sent into a queue that replaced the subscriber's under its name).
+ * The watchdog catches what nobody reports (a stopped publisher, a
+ * notification sent into a queue that replaced the subscriber's under its
+ * name): when the subscriber has not looked AGNOCAST_WAKE_WATCHDOG_MS after
+ * the listing, its process's wake eventfd is signalled, once per listing.
+ * It does not list the subscriber again: a subscriber that is merely slow,
+ * or stopped, keeps one notification pending, not one per PUBLISH.
  * A broken promise that was kept after all costs one RECEIVE that finds
  * nothing.
  */
@@ -37,11 +40,7 @@ static void agnocast_wake_signal(struct agnocast_proc *proc)
 #endif
 }
 
-/*
- * The subscriber's promise is broken.  Under its topic's lock, or under the
- * namespace lock for write; from the watchdog, under neither: the flag is
- * then only cleared, which at worst makes a PUBLISH list it once more.
- */
+/* The subscriber's promise is broken (its topic's lock, or the namespace lock for write). */
 void agnocast_wake_break(struct agnocast_subscriber *sub)
 {
 	WRITE_ONCE(sub->notified, false);
@@ -60,7 +59,8 @@ static void agnocast_wake_watchdog(struct timer_list *timer)
 		mod_timer(&sub->watchdog, due);
 		return;
 	}
-	agnocast_wake_break(sub);
+	/* Under no lock: the flags are only read, and a signal is always safe. */
+	agnocast_wake_signal(sub->ep.proc);
 }
 
 void agnocast_wake_sub_init(struct agnocast_subscriber *sub)

@@ -84,11 +84,13 @@
  * notification.  When it may not have been kept, the subscriber is listed
  * again by the next PUBLISH and its process's wake eventfd (REGISTER_PROCESS)
  * is signalled at once: when the publisher's process dies while the
- * subscriber has not looked since, when the publisher reports that it could
- * not notify (NOTIFY_FAILED), and when the subscriber has not looked within
- * AGNOCAST_WAKE_WATCHDOG_MS of being listed, whatever the cause (a stopped
- * publisher, a queue replaced under its name).  The same holds for callback
- * subscribers without the flag, which are listed by every PUBLISH.
+ * subscriber has not looked since, and when the publisher reports that it
+ * could not notify (NOTIFY_FAILED).  When the subscriber has not looked
+ * AGNOCAST_WAKE_WATCHDOG_MS after it was first listed, whatever the cause (a
+ * stopped publisher, a queue replaced under its name, or just a busy or
+ * stopped subscriber), its process's wake eventfd is signalled, once per
+ * listing, and nothing more.  The same holds for callback subscribers
+ * without the flag, which are listed by every PUBLISH.
  */
 #define AGNOCAST_WAKE_ONCE (1U << 4)
 #define AGNOCAST_WAKE_WATCHDOG_MS 50

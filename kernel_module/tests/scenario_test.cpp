@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <thread>
 
@@ -218,9 +219,17 @@ int take(int dev, Endpoint sub, ReceiveResult* res) {
 // must take its pool out of the answer: a dead pool's file mapped at its
 // address would hide the pool that gets its slot next. A thread publishes
 // into the depth-1 subscription after a delay swept across attempts, so that
-// some drops land while the dead child's pool is being installed.
+// some drops land while the dead child's pool is being installed. The call
+// starts once the dropper counts the delay, so that a dropper scheduled late
+// (a loaded host) still drops within the sweep.
 void race_drop_against_install(int dev, const Registration& reg, bool polling) {
+  // Both outcomes (the child's entry received, or dropped first) must occur
+  // for the race to have been run at all. A round of kAttempts that lacks
+  // one is followed by another, with the delays four times as long (up to
+  // 256 times) if no child's entry was received, until both have occurred or
+  // kOvertime has passed.
   constexpr int kAttempts = 150;
+  constexpr auto kOvertime = std::chrono::seconds(60);
   const std::string topic = polling ? "/stray_grant_take" : "/stray_grant_receive";
   Endpoint sub, own;
   ASSERT_EQ(add_subscriber(dev, topic, 1, &sub, polling ? AGNOCAST_POLLING : 0), 0);
@@ -229,8 +238,9 @@ void race_drop_against_install(int dev, const Registration& reg, bool polling) {
     return polling ? take(dev, sub, rr) : receive(dev, sub, rr, 1);
   };
 
-  // The delay (in spins) before the next drop; kIdle between attempts.
-  constexpr int kIdle = -1, kEnd = -2;
+  // The delay (in spins) before the next drop; kIdle between attempts,
+  // kCounting while the dropper counts it.
+  constexpr int kIdle = -1, kEnd = -2, kCounting = -3;
   std::atomic<int> drop_after{kIdle};
   std::atomic<int> drop_failures{0};
   std::thread dropper([&] {
@@ -238,6 +248,7 @@ void race_drop_against_install(int dev, const Registration& reg, bool polling) {
       int spins;
       while ((spins = drop_after.load()) == kIdle) sched_yield();
       if (spins == kEnd) return;
+      drop_after.store(kCounting);
       for (int s = 0; s < spins; s++) __asm__ volatile("");
       if (publish(dev, own, reg.addr + (i % 4096) * 64)) drop_failures++;
       drop_after.store(kIdle);
@@ -253,8 +264,8 @@ void race_drop_against_install(int dev, const Registration& reg, bool polling) {
     }
   } stop_dropper{drop_after, dropper};
 
-  int received_child = 0, pools_handed = 0;
-  auto check = [&](const ReceiveResult& rr, int attempt) {
+  int attempt = 0, received_child = 0, pools_handed = 0;
+  auto check = [&](const ReceiveResult& rr) {
     for (const auto& pool : rr.pools) {
       const bool holds = std::any_of(rr.entries.begin(), rr.entries.end(), [&](const auto& e) {
         return e.addr >= pool.addr && e.addr < pool.addr + pool.size;
@@ -269,7 +280,15 @@ void race_drop_against_install(int dev, const Registration& reg, bool polling) {
       EXPECT_EQ(release(dev, sub, e.entry_id), 0);
     }
   };
-  for (int attempt = 0; attempt < kAttempts && !::testing::Test::HasFailure(); attempt++) {
+  const auto overtime_end = std::chrono::steady_clock::now() + kOvertime;
+  int delay_scale = 1;
+  for (; !::testing::Test::HasFailure(); attempt++) {
+    if (attempt && attempt % kAttempts == 0) {
+      if ((received_child > 0 && received_child < attempt) ||
+          std::chrono::steady_clock::now() > overtime_end)
+        break;
+      if (!received_child) delay_scale = std::min(delay_scale * 4, 256);
+    }
     Pipe ready;
     pid_t child = fork();
     if (child == 0) {
@@ -288,21 +307,21 @@ void race_drop_against_install(int dev, const Registration& reg, bool polling) {
     ASSERT_EQ(waitpid(child, &status, 0), child);
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
 
-    drop_after.store((attempt * 37) % 4000);
+    drop_after.store((attempt * 37) % 4000 * delay_scale);
+    while (drop_after.load() >= 0) sched_yield();
     ReceiveResult rr;
     ASSERT_EQ(answer(&rr), 0);
     while (drop_after.load() != kIdle) sched_yield();
-    check(rr, attempt);
+    check(rr);
     ReceiveResult rest;
     ASSERT_EQ(answer(&rest), 0);
-    check(rest, attempt);
+    check(rest);
   }
   EXPECT_EQ(drop_failures.load(), 0);
-  // Both outcomes must occur for the race to have been run at all.
-  std::printf("%d of %d children's entries received, %d pools handed over\n", received_child,
-              kAttempts, pools_handed);
+  std::printf("%d of %d children's entries received, %d pools handed over (delays x%d)\n",
+              received_child, attempt, pools_handed, delay_scale);
   EXPECT_GT(received_child, 0);
-  EXPECT_LT(received_child, kAttempts);
+  EXPECT_LT(received_child, attempt);
 }
 
 TEST_F(Scenario, ReceiveHandsOverOnlyThePoolsOfItsEntries) {

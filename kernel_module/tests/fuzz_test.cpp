@@ -8,7 +8,18 @@
 // beside the fuzzer) reloading access policies on SIGHUP.  A share of the steps are garbage
 // (random commands, arguments and bad pointers), a share well-formed and
 // stateful (a pool allocator, tagged messages, receives that release what
-// they hold), so that every command's success path is reached.  Checked
+// they hold), so that every command's success path is reached.  Beside the
+// workers, a listener process in each namespace (both at home with
+// --no-namespaces) holds callback subscribers that speak the notification
+// protocol: each sleeps on its queue and on its process's wake eventfd, and
+// on either RECEIVEs until nothing remains.  A well-formed PUBLISH notifies
+// them as libagnocast does, with faults on that path: a process killed
+// between two of its calls (after PUBLISH, between mq_open and mq_send,
+// between two sends; a listener after taking a notification or reading its
+// wake eventfd, between RECEIVE and RELEASE, between two RECEIVEs),
+// notifications left unsent, reported with NOTIFY_FAILED or not, and
+// listeners' queues unlinked under them and at times replaced by another
+// queue of that name; a process a fault killed is back at once.  Checked
 // while it runs:
 //  - every message a subscriber reads carries the tag its publisher wrote:
 //    the subscriber's topic, the entry's publisher and address, a checksum;
@@ -20,11 +31,19 @@
 //  - messages carry their namespace too, and no worker is ever registered
 //    in the namespace it does not live in; nothing a thread visiting the
 //    other namespace asks there succeeds;
+//  - whatever a listener's subscriber is given (received + unreceived +
+//    dropped) it receives or drops within 5 s (kLivenessBound), and while
+//    entries wait for it, it receives one within 5 s (drops retire entries
+//    too, under a subscriber that sleeps on): checked by the parent every
+//    few hundred milliseconds, a lost wake-up fails it;
+//  - a command number of the module's type that the UAPI does not define
+//    fails with ENOTTY;
 //  - the module's parameters (its quotas) cannot change while it runs;
 // and at the end that every process and topic is gone in both namespaces,
 // that the second namespace's state went with it, that the module's entry
 // cache holds no more objects than before, and that agnocastd exits 0.  It prints, per
-// command, successes and each errno, and fails if a command never succeeded.
+// command, successes and each errno, and fails if a command never succeeded
+// or no wake eventfd ever woke a listener.
 // A failure prints the seed and the last operations of the thread that saw
 // it.  The VM bed checks the kernel log.
 //
@@ -38,9 +57,11 @@
 //   --caps: always, --no-caps: never).  A third of the workers live in the
 //   second IPC namespace; with --no-namespaces threads only visit it.
 #include <dirent.h>
+#include <mqueue.h>
 #include <poll.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/eventfd.h>
 #include <sys/mount.h>
 #include <sys/prctl.h>
 #include <sys/syscall.h>
@@ -49,9 +70,11 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <shared_mutex>
 #include <tuple>
@@ -84,6 +107,7 @@ enum Row : int {
   kSetPolicy,
   kGetPolicy,
   kTopicSchema,
+  kNotifyFailed,
   kUnknown,
   kReceiveEntries,   // RECEIVE that returned entries
   kReceiveReleases,  // RECEIVE that released entries
@@ -112,6 +136,7 @@ const char* const kRowNames[kRows] = {"GET_VERSION",
                                       "SET_POLICY",
                                       "GET_POLICY",
                                       "TOPIC_SCHEMA",
+                                      "NOTIFY_FAILED",
                                       "(unknown command)",
                                       " RECEIVE entries",
                                       " RECEIVE releases",
@@ -139,6 +164,7 @@ const unsigned long kCommands[kUnknown] = {
     AGNOCAST_IOC_SET_POLICY,
     AGNOCAST_IOC_GET_POLICY,
     AGNOCAST_IOC_TOPIC_SCHEMA,
+    AGNOCAST_IOC_NOTIFY_FAILED,
 };
 constexpr int kErrnos = 134;  // errno values counted one by one; larger ones share the last
 const char* const kTopics[] = {"/a", "/a/b", "/a_b", "/chatter", "/x/y/z", "/x_y/z", "/q"};
@@ -148,6 +174,35 @@ constexpr int kTakenMax = 8192;
 // Workers live in two IPC namespaces: the parent's (0) and a second one (1)
 // that a holder process keeps alive for the run.
 constexpr int kNamespaces = 2;
+// Listeners (struct Listener): processes of callback subscribers that
+// speak the notification protocol and nothing else.  What is published to
+// them must be received or dropped within kLivenessBound: the mechanism's
+// own bound is the next PUBLISH or the module's watchdog
+// (AGNOCAST_WAKE_WATCHDOG_MS); this one leaves room for TCG and the debug
+// kernel.
+constexpr int kListeners = 2;
+constexpr int kListenerSubs = 3;
+constexpr auto kLivenessBound = std::chrono::milliseconds(5000);
+
+// Where a process kills itself on the message path, between two of its
+// system calls.
+enum KillPoint : int {
+  kAfterPublish,       // PUBLISH listed subscribers, no notification sent
+  kAfterOpen,          // a subscriber's queue opened, its notification not sent
+  kBetweenSends,       // one notification sent, the next not
+  kAfterNotification,  // a listener took a notification, did not RECEIVE
+  kAfterWakeEventfd,   // a listener read its wake eventfd, did not RECEIVE
+  kBeforeRelease,      // a listener RECEIVEd entries, did not release them
+  kBetweenReceives,    // a listener RECEIVEd, entries remain
+  kKillPoints
+};
+const char* const kKillPointNames[kKillPoints] = {"after PUBLISH",
+                                                  "between mq_open and mq_send",
+                                                  "between two sends",
+                                                  "after taking a notification",
+                                                  "after reading the wake eventfd",
+                                                  "between RECEIVE and RELEASE",
+                                                  "between two RECEIVEs"};
 
 // Shared by the parent and every worker (an anonymous shared mapping).
 struct Shared {
@@ -176,6 +231,21 @@ struct Shared {
   // Events of the world around the commands.
   std::atomic<uint64_t> forks, device_swaps, members, non_members, execs;
   std::atomic<uint64_t> ns_workers, ns_visits, ns_probes;
+  // Listener processes.  Each shows the queues it owns, so that workers can
+  // unlink them: (topic + 1) << 32 | subscriber id, 0 for none.
+  struct Listener {
+    std::atomic<int> pid;
+    std::atomic<int> ns;
+    std::atomic<uint64_t> queues[kListenerSubs];
+    std::atomic<int64_t> last_wake;  // CLOCK_MONOTONIC, ns
+  } listeners[kListeners];
+  std::atomic<uint64_t> listener_entries, queue_wakes, eventfd_wakes;
+  // The faults on the message path: processes killed at each point;
+  // notifications sent, left unsent and reported (NOTIFY_FAILED), left
+  // unsent silently, reported after a failed mq_open or mq_send; queues
+  // unlinked under their listener, and replaced by another one.
+  std::atomic<uint64_t> kills[kKillPoints];
+  std::atomic<uint64_t> sent, unsent_reported, unsent_silent, send_failed, unlinked, replaced;
   // Descriptors of the two namespaces (/proc/PID/ns/ipc), open in every
   // worker, kept across exec.
   int ns_fd[kNamespaces];
@@ -236,6 +306,39 @@ void report(const char* what, int got, uint64_t seed) {
                         static_cast<unsigned long long>(seed), getpid(), what,
                         got ? strerrorname_np(got) : "0");
   if (n > 0) (void)!write(1, line, std::min<size_t>(static_cast<size_t>(n), sizeof(line) - 1));
+}
+
+// The name libagnocast gives a callback subscriber's notification queue
+// (agnocast/naming.hpp): every '/' of the topic after the first made '_',
+// then '@' and the subscriber id.
+std::string queue_name(int topic, uint32_t id) {
+  std::string name = kTopics[topic];
+  std::replace(name.begin() + 1, name.end(), '/', '_');
+  return name + "@" + std::to_string(id);
+}
+
+uint64_t queue_key(int topic, uint32_t id) { return static_cast<uint64_t>(topic + 1) << 32 | id; }
+
+// Whether a listener of namespace @ns owns the queue of subscriber @id of @topic.
+bool listener_queue(int ns, int topic, uint32_t id) {
+  for (auto& l : sh->listeners)
+    if (l.ns == ns)
+      for (auto& q : l.queues)
+        if (q == queue_key(topic, id)) return true;
+  return false;
+}
+
+// The process dies here, at once: no step after this one happens.
+[[noreturn]] void die(KillPoint point) {
+  sh->kills[point]++;
+  kill(getpid(), SIGKILL);
+  for (;;) pause();
+}
+
+int64_t monotonic_ns() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
 // A well-formed message: what a publisher writes at the start of a slot.
@@ -361,7 +464,8 @@ struct Worker {
   Arena arena;
   std::vector<Ep> pubs, subs;
   std::vector<Held> held;
-  std::vector<uint64_t> entries;  // ids for garbage releases
+  std::vector<uint64_t> entries;      // ids for garbage releases
+  std::map<uint64_t, mqd_t> senders;  // queue_key() -> a queue opened for sending
   OpRecord ring[64] = {};
   uint64_t nops = 0;
   bool reported = false;
@@ -516,8 +620,9 @@ struct Worker {
   // --- Garbage ----------------------------------------------------------
 
   void garbage() {
+    // The kernel sees 32 bits of a command.
     unsigned long cmd = kCommands[rnd(std::size(kCommands))];
-    if (chance(10)) cmd = static_cast<unsigned long>(rng());
+    if (chance(10)) cmd = static_cast<uint32_t>(rng());
     if (chance(10)) cmd ^= 1ul << rnd(32);
     // Not these: they would unregister or hand out pools behind the
     // bookkeeping's back.
@@ -534,8 +639,12 @@ struct Worker {
     // A garbage PUBLISH that succeeds is of an unknown topic.
     bool pub = cmd == AGNOCAST_IOC_PUBLISH;
     if (pub) publishing() = kNumTopics + 1;
-    if (call(cmd, arg, uptr(arg)) == 0 && pub) make_uncertain(-1);
+    const int ret = call(cmd, arg, uptr(arg));
+    if (ret == 0 && pub) make_uncertain(-1);
     if (pub) publishing() = 0;
+    // kCommands holds every command of the UAPI: any other of its type is unknown.
+    if (row_of(cmd) == kUnknown && _IOC_TYPE(cmd) == AGNOCAST_IOC_MAGIC && ret != ENOTTY)
+      report("a command number the UAPI does not define did not fail with ENOTTY", ret, proc->seed);
   }
 
   void add_endpoint(bool publisher, bool wellformed) {
@@ -614,7 +723,16 @@ struct Worker {
     uint64_t addrs[AGNOCAST_RECLAIM_BATCH];
     uint32_t n = std::min<uint32_t>(arg.reclaim_count, AGNOCAST_RECLAIM_BATCH);
     std::memcpy(addrs, reinterpret_cast<const void*>(arg.reclaim), n * sizeof(uint64_t));
-    proc->reclaimed(addrs, n);
+    // The kernel writes the wake ids after the addresses: where the two
+    // buffers overlap, an "address" may read as the pool's base plus an id,
+    // a slot still in use.  Only addresses no wake id overwrote are trusted.
+    const uint64_t wake_end = arg.wake_ids + uint64_t{arg.wake_count} * sizeof(uint32_t);
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < n; i++) {
+      const uint64_t at = arg.reclaim + i * sizeof(uint64_t);
+      if (at + sizeof(uint64_t) <= arg.wake_ids || at >= wake_end) addrs[kept++] = addrs[i];
+    }
+    proc->reclaimed(addrs, kept);
   }
 
   void do_receive() {
@@ -893,6 +1011,88 @@ struct Worker {
     }
     if (arg.reclaim_count) count(kPublishReclaim, 0);
     proc->reclaimed(reclaim, arg.reclaim_count);
+    notify(e, topic, wake, arg.wake_count);
+  }
+
+  // What libagnocast's publisher does after a PUBLISH: a notification to
+  // each subscriber it listed, NOTIFY_FAILED for one it could not send.
+  // Listeners get the faults: the process dies between two of these calls,
+  // or a notification is left unsent, reported or not (the module's
+  // watchdog must then wake the subscriber).  The other subscribers have no
+  // queue: now and then they get what a missing queue gets.
+  void notify(const Ep& e, int topic, const uint32_t* ids, uint32_t n) {
+    // Only a PUBLISH that listed a listener is cut short: nobody else waits.
+    const bool lists_listener =
+        std::any_of(ids, ids + n, [&](uint32_t id) { return listener_queue(proc->ns, topic, id); });
+    const int kill_at = lists_listener && !rnd(50) ? static_cast<int>(rnd(3)) : -1;
+    if (kill_at == kAfterPublish) die(kAfterPublish);
+    for (uint32_t i = 0; i < n; i++) {
+      if (i && kill_at == kBetweenSends) die(kBetweenSends);
+      if (!listener_queue(proc->ns, topic, ids[i])) {
+        if (chance(10) && !send_notification(topic, ids[i], false)) notify_failed(e, ids[i]);
+        continue;
+      }
+      if (chance(3)) {
+        sh->unsent_silent++;
+      } else if (chance(3)) {
+        sh->unsent_reported++;
+        notify_failed(e, ids[i]);
+      } else if (send_notification(topic, ids[i], kill_at == kAfterOpen)) {
+        sh->sent++;
+      } else {
+        sh->send_failed++;
+        notify_failed(e, ids[i]);
+      }
+    }
+  }
+
+  // One notification, through a descriptor kept per subscriber as
+  // libagnocast keeps it; false when the queue could not be opened or the
+  // send failed other than for a full queue (which holds a wake-up already).
+  // @die_before_send: the process dies with the queue open, before the send.
+  bool send_notification(int topic, uint32_t id, bool die_before_send) {
+    auto it = senders.find(queue_key(topic, id));
+    if (it == senders.end()) {
+      const mqd_t q = mq_open(queue_name(topic, id).c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+      if (q == -1) return false;
+      if (senders.size() >= 32) {
+        for (const auto& [key, open] : senders) mq_close(open);
+        senders.clear();
+      }
+      it = senders.emplace(queue_key(topic, id), q).first;
+    }
+    if (die_before_send) die(kAfterOpen);
+    const char byte = 0;
+    if (mq_send(it->second, &byte, 1, 0) == 0 || errno == EAGAIN) return true;
+    mq_close(it->second);
+    senders.erase(it);
+    return false;
+  }
+
+  void notify_failed(const Ep& e, uint32_t subscriber_id) {
+    agnocast_notify_failed arg{e.handle, e.id, subscriber_id, 0};
+    call(AGNOCAST_IOC_NOTIFY_FAILED, &arg, e.handle, subscriber_id);
+  }
+
+  // A listener's queue unlinked under it and, half the time, another one
+  // made under its name, which its publishers then open (libagnocast never
+  // makes its queue again): the listener's wake eventfd must still wake it.
+  void unlink_listener_queue() {
+    const auto& l = sh->listeners[rnd(kListeners)];
+    const uint64_t key = l.queues[rnd(kListenerSubs)];
+    if (l.ns != proc->ns || !key) return;
+    const std::string name =
+        queue_name(static_cast<int>((key >> 32) - 1), static_cast<uint32_t>(key));
+    if (mq_unlink(name.c_str()) == 0) sh->unlinked++;
+    if (chance(50)) return;
+    mq_attr attr{};
+    attr.mq_maxmsg = 1 + static_cast<long>(rnd(2));
+    attr.mq_msgsize = 1;
+    const mqd_t q =
+        mq_open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NONBLOCK | O_CLOEXEC, 0622, &attr);
+    if (q == -1) return;
+    sh->replaced++;
+    mq_close(q);
   }
 
   void wf_receive() {
@@ -1209,6 +1409,7 @@ struct Worker {
         if (owns_registration && chance(2)) return fork_child();
         if (owns_registration && chance(1)) return exec_self();
         if (owns_registration && chance(4)) return visit_other_ns();
+        if (chance(3)) return unlink_listener_queue();
         return;
       case 3:
         return add_endpoint(true, false);
@@ -1329,6 +1530,197 @@ void identity(Process* proc, uint64_t seed) {
   }
 }
 
+// --- Listeners ---------------------------------------------------------------
+
+// A process of callback subscribers that does for them what libagnocast's
+// executor does, and nothing else: it sleeps on their queues and on its
+// wake eventfd (REGISTER_PROCESS with AGNOCAST_REGISTER_WAKE_EVENTFD), and
+// on either RECEIVEs until nothing remains, taking one notification before
+// or after.  The parent checks that nothing published to them waits
+// (check_liveness()).  It dies now and then between two of its calls, and
+// a subscriber of it goes with its queue and another one comes.
+struct Listener {
+  struct Sub {
+    Ep ep;  // ep.topic < 0: none
+    mqd_t queue = -1;
+    std::vector<uint64_t> held;  // released by the next RECEIVE, or by RELEASE at once
+  };
+
+  Listener(int slot, uint64_t seed) : rng(seed), seed(seed), shown(sh->listeners[slot]) {}
+  std::mt19937_64 rng;
+  uint64_t seed;
+  Shared::Listener& shown;
+  int dev = -1;
+  int wake = -1;
+  bool drain_first = false;     // takes the notification before its RECEIVEs
+  bool batch_releases = false;  // releases within the next RECEIVE, as libagnocast does
+  Sub subs[kListenerSubs];
+
+  uint64_t rnd(uint64_t n) { return n ? rng() % n : 0; }
+  bool chance(int percent) { return rnd(100) < static_cast<uint64_t>(percent); }
+  void maybe_die(KillPoint point) {
+    if (!rnd(100)) die(point);
+  }
+
+  [[noreturn]] void run(int ns) {
+    shown.pid = getpid();
+    if (!start(ns)) {
+      report("a listener could not open the device and register with its wake eventfd", errno,
+             seed);
+      _exit(0);
+    }
+    drain_first = chance(50);
+    batch_releases = chance(50);
+    const int wanted = 1 + static_cast<int>(rnd(kListenerSubs));
+    for (int64_t next_change = 0;;) {
+      // The missing subscribers come (again, when a policy or a cap refused
+      // them); now and then one goes with its queue.
+      if (monotonic_ns() >= next_change) {
+        next_change = monotonic_ns() + 100000000;
+        for (int i = 0; i < wanted; i++) {
+          if (subs[i].ep.topic < 0)
+            add_subscriber(i);
+          else if (!rnd(300))
+            remove_subscriber(i);
+        }
+      }
+      wait();
+    }
+  }
+
+  // The wake eventfd goes with the first step of REGISTER_PROCESS, or with
+  // a repeated first step, before any subscriber.
+  bool start(int ns) {
+    if (ns && setns(sh->ns_fd[ns], CLONE_NEWIPC)) return false;
+    dev = open_device();
+    wake = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+    if (dev < 0 || wake < 0) return false;
+    const bool at_once = chance(70);
+    return register_step(at_once) == 0 && (at_once || register_step(true) == 0);
+  }
+
+  int register_step(bool with_wake_eventfd) {
+    agnocast_register_process reg{};
+    reg.pool_fd = -1;
+    if (with_wake_eventfd) {
+      reg.flags = AGNOCAST_REGISTER_WAKE_EVENTFD;
+      reg.wake_fd = wake;
+    }
+    return counted_ioctl(kRegister, dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg);
+  }
+
+  void add_subscriber(int i) {
+    Sub& s = subs[i];
+    const int topic = static_cast<int>(rnd(kNumTopics));
+    const uint32_t flags = chance(75) ? AGNOCAST_WAKE_ONCE : 0;
+    auto ep = endpoint(kTopics[topic], 1 + static_cast<uint32_t>(rnd(8)), flags, "listener");
+    if (counted_ioctl(kAddSubscriber, dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep)) return;
+    s.ep = {ep.topic_handle, ep.id, topic, flags, 0};
+    // Made as libagnocast makes it: a queue there under its name is a leftover.
+    const std::string name = queue_name(topic, ep.id);
+    mq_attr attr{};
+    // Taking the notification after the RECEIVEs needs room for two.
+    attr.mq_maxmsg = static_cast<long>(drain_first ? 1 + rnd(3) : 2 + rnd(2));
+    attr.mq_msgsize = 1;
+    for (int tries = 0; tries < 3 && s.queue == -1; tries++) {
+      s.queue =
+          mq_open(name.c_str(), O_RDONLY | O_CREAT | O_EXCL | O_NONBLOCK | O_CLOEXEC, 0622, &attr);
+      if (s.queue == -1 && errno == EEXIST) mq_unlink(name.c_str());
+    }
+    if (s.queue == -1 || fchmod(s.queue, 0622)) {
+      report("a listener could not make its queue", errno, seed);
+      remove_subscriber(i);
+      return;
+    }
+    shown.queues[i] = queue_key(topic, ep.id);
+    // Listed before its queue was there, it may have missed its notification.
+    receive_all(s);
+  }
+
+  void remove_subscriber(int i) {
+    Sub& s = subs[i];
+    shown.queues[i] = 0;
+    if (s.queue != -1) {
+      mq_close(s.queue);
+      mq_unlink(queue_name(s.ep.topic, s.ep.id).c_str());
+    }
+    agnocast_remove_endpoint rm{s.ep.handle, s.ep.id};
+    counted_ioctl(kRemoveSubscriber, dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm);
+    s = Sub{};
+  }
+
+  // Sleeps until a queue or the wake eventfd says there is something, and
+  // receives it.
+  void wait() {
+    pollfd fds[kListenerSubs + 1] = {{wake, POLLIN, 0}};
+    int sub_of[kListenerSubs + 1];
+    nfds_t n = 1;
+    for (int i = 0; i < kListenerSubs; i++) {
+      if (subs[i].ep.topic < 0) continue;
+      sub_of[n] = i;
+      fds[n++] = {subs[i].queue, POLLIN, 0};
+    }
+    if (poll(fds, n, 100) <= 0) return;
+    shown.last_wake = monotonic_ns();
+    uint64_t signals;
+    if ((fds[0].revents & POLLIN) && read(wake, &signals, sizeof(signals)) == sizeof(signals)) {
+      sh->eventfd_wakes++;
+      maybe_die(kAfterWakeEventfd);
+      for (Sub& s : subs)
+        if (s.ep.topic >= 0) receive_all(s);
+    }
+    for (nfds_t k = 1; k < n; k++) {
+      if (!(fds[k].revents & POLLIN)) continue;
+      Sub& s = subs[sub_of[k]];
+      char byte;
+      sh->queue_wakes++;
+      if (drain_first) {
+        (void)!mq_receive(s.queue, &byte, 1, nullptr);
+        maybe_die(kAfterNotification);
+      }
+      receive_all(s);
+      if (!drain_first) (void)!mq_receive(s.queue, &byte, 1, nullptr);
+    }
+  }
+
+  // RECEIVEs until nothing remains.
+  void receive_all(Sub& s) {
+    for (;;) {
+      agnocast_entry ents[4];
+      agnocast_pool pools[AGNOCAST_RECEIVE_POOLS_MAX];
+      agnocast_receive arg{};
+      arg.topic_handle = s.ep.handle;
+      arg.subscriber_id = s.ep.id;
+      arg.entries = uptr(ents);
+      arg.pools = uptr(pools);
+      arg.entry_capacity = 1 + static_cast<uint32_t>(rnd(std::size(ents)));
+      arg.pool_capacity = AGNOCAST_RECEIVE_POOLS_MAX;
+      arg.release_ids = uptr(s.held.data());
+      arg.release_count = static_cast<uint32_t>(s.held.size());
+      if (int ret = counted_ioctl(kReceive, dev, AGNOCAST_IOC_RECEIVE, &arg)) {
+        report("a listener's RECEIVE failed", ret, seed);
+        return;
+      }
+      if (arg.release_count) count(kReceiveReleases, 0);
+      if (arg.entry_count) count(kReceiveEntries, 0);
+      s.held.clear();
+      for (uint32_t i = 0; i < arg.pool_count; i++) close(pools[i].fd);
+      for (uint32_t i = 0; i < arg.entry_count; i++) s.held.push_back(ents[i].entry_id);
+      sh->listener_entries += arg.entry_count;
+      if (!batch_releases && !s.held.empty()) {
+        maybe_die(kBeforeRelease);
+        agnocast_release rel{s.ep.handle, s.ep.id, uptr(s.held.data()),
+                             static_cast<uint32_t>(s.held.size()), 0};
+        if (int ret = counted_ioctl(kRelease, dev, AGNOCAST_IOC_RELEASE, &rel))
+          report("a listener's RELEASE failed", ret, seed);
+        s.held.clear();
+      }
+      if (!arg.remaining) return;
+      maybe_die(kBetweenReceives);
+    }
+  }
+};
+
 // --- The parent's audit of the kernel's counters ---------------------------
 
 struct SubSnapshot {
@@ -1445,6 +1837,90 @@ bool audit(int dev, const std::vector<pid_t>& workers) {
   last_audit = std::move(now);
   audits++;
   sh->pause = false;
+  return ok;
+}
+
+// --- The parent's liveness check of the listeners ---------------------------
+
+// A listener's subscriber as the parent saw it.
+struct Backlog {
+  using Clock = std::chrono::steady_clock;
+  // What it had been given (received + unreceived + dropped) each time the
+  // parent saw more given than received or dropped, and when.
+  std::deque<std::pair<Clock::time_point, uint64_t>> given;
+  // Since when entries have waited for it while it received none (drops
+  // retire entries too: a subscriber that sleeps on while new entries push
+  // the old ones out receives nothing), and what it had received then.
+  std::optional<Clock::time_point> starved_since;
+  uint64_t received = 0;
+  bool reported = false;
+};
+// (namespace, topic, subscriber id, pid)
+std::map<std::tuple<int, int, uint32_t, int>, Backlog> backlogs;
+uint64_t liveness_checks = 0;
+Backlog::Clock::duration longest_wait{};
+
+// Whatever a listener's subscriber is given, it receives or drops within
+// kLivenessBound, and while entries wait for it, it receives one within
+// kLivenessBound.  Listeners never pause: this holds through audits too.
+bool check_liveness(int dev) {
+  using std::chrono::duration_cast;
+  using std::chrono::milliseconds;
+  bool ok = true;
+  const auto now = Backlog::Clock::now();
+  decltype(backlogs) seen;
+  std::vector<agnocast_subscriber_info> subs(2048);
+  for (int ns = 0; ns < kNamespaces; ns++) {
+    if (!enter_ns(ns)) continue;
+    for (int t = 0; t < kNumTopics; t++) {
+      agnocast_topic_info info{};
+      std::strcpy(info.name, kTopics[t]);
+      info.subscribers = uptr(subs.data());
+      info.subscriber_capacity = static_cast<uint32_t>(subs.size());
+      if (ioc(dev, AGNOCAST_IOC_TOPIC_INFO, &info)) continue;
+      for (uint32_t i = 0; i < std::min<uint32_t>(info.subscriber_total, 2048); i++) {
+        const auto& s = subs[i];
+        const Shared::Listener* listener = nullptr;
+        for (const auto& l : sh->listeners)
+          if (l.pid == s.pid && l.ns == ns) listener = &l;
+        if (!listener) continue;
+        const auto key = std::make_tuple(ns, t, s.id, s.pid);
+        Backlog& b = seen[key] = std::move(backlogs[key]);
+        const uint64_t done = s.received + s.dropped, given = done + s.unreceived;
+        while (!b.given.empty() && b.given.front().second <= done) b.given.pop_front();
+        if (given > done && (b.given.empty() || b.given.back().second < given))
+          b.given.emplace_back(now, given);
+        if (!s.unreceived || s.received != b.received) b.starved_since.reset();
+        if (s.unreceived && !b.starved_since) b.starved_since = now;
+        b.received = s.received;
+        liveness_checks++;
+        const Backlog::Clock::duration none{};
+        const auto unretired = b.given.empty() ? none : now - b.given.front().first;
+        const auto starved = b.starved_since ? now - *b.starved_since : none;
+        longest_wait = std::max({longest_wait, unretired, starved});
+        if (std::max(unretired, starved) <= kLivenessBound || b.reported) continue;
+        b.reported = true;
+        ok = false;
+        const bool starving = starved > kLivenessBound;
+        std::printf(
+            "fuzz: FAIL: liveness: %s subscriber %u of IPC namespace %d (listener pid %d, flags "
+            "%u): for %lld ms %s (bound %lld ms); received %llu, unreceived %u, dropped %llu; "
+            "its listener last woke %lld ms ago\n",
+            kTopics[t], s.id, ns, s.pid, s.flags,
+            static_cast<long long>(
+                duration_cast<milliseconds>(starving ? starved : unretired).count()),
+            starving ? "entries waited while it received none"
+                     : "entries given to it were neither received nor dropped",
+            static_cast<long long>(kLivenessBound.count()),
+            static_cast<unsigned long long>(s.received), s.unreceived,
+            static_cast<unsigned long long>(s.dropped),
+            static_cast<long long>((monotonic_ns() - listener->last_wake) / 1000000));
+        std::fflush(stdout);
+      }
+    }
+  }
+  enter_ns(0);
+  backlogs = std::move(seen);
   return ok;
 }
 
@@ -1809,6 +2285,35 @@ int main(int argc, char** argv) {
     workers[i] = pid;
   };
   for (int i = 0; i < nprocs; i++) spawn(i);
+  // Listeners: one at home, one in the second namespace (with --namespaces).
+  std::vector<pid_t> listeners(kListeners);
+  uint64_t listener_spawns = 0;
+  auto spawn_listener = [&](int k) {
+    auto& l = sh->listeners[k];
+    l.ns = namespaces && k % 2 ? 1 : 0;
+    l.last_wake = monotonic_ns();
+    const uint64_t seed = (base_seed + listener_spawns++) * 0x9E3779B97F4A7C15ull;
+    pid_t pid = fork();
+    if (pid == 0) Listener(k, seed).run(l.ns);
+    l.pid = pid;
+    listeners[k] = pid;
+  };
+  // A dead listener's queues go, as agnocastd removes a dead subscriber's
+  // queues in its own namespace.
+  auto bury_listener = [&](int k) {
+    auto& l = sh->listeners[k];
+    std::vector<uint64_t> keys;
+    for (auto& q : l.queues)
+      if (uint64_t key = q.exchange(0)) keys.push_back(key);
+    if (!enter_ns(l.ns)) return;
+    for (uint64_t key : keys) {
+      const int topic = static_cast<int>((key >> 32) - 1);
+      if (!listener_queue(l.ns, topic, static_cast<uint32_t>(key)))
+        mq_unlink(queue_name(topic, static_cast<uint32_t>(key)).c_str());
+    }
+    enter_ns(0);
+  };
+  for (int k = 0; k < kListeners; k++) spawn_listener(k);
 
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = start + std::chrono::seconds(seconds);
@@ -1829,6 +2334,23 @@ int main(int argc, char** argv) {
       ok &= parameters_fixed(parameters);
       next_reload = now + std::chrono::milliseconds(1500 + rng() % 2000);
     }
+    // Processes killed by a fault come back at once (a worker that ended on
+    // its own waits for the parent's pick).
+    for (int k = 0; k < kListeners; k++) {
+      if (waitpid(listeners[k], nullptr, WNOHANG) != listeners[k]) continue;
+      bury_listener(k);
+      spawn_listener(k);
+    }
+    for (int i = 0; i < nprocs; i++) {
+      siginfo_t info{};
+      if (waitid(P_PID, static_cast<id_t>(workers[i]), &info, WEXITED | WNOHANG | WNOWAIT) ||
+          info.si_pid != workers[i] || info.si_code != CLD_KILLED)
+        continue;
+      waitpid(workers[i], nullptr, 0);
+      settle_slot(i);
+      spawn(i);
+    }
+    ok &= check_liveness(dev);
     if (now >= next_report) {
       std::printf("fuzz: %llu operations after %lld s\n",
                   static_cast<unsigned long long>(sh->ops.load()),
@@ -1848,6 +2370,10 @@ int main(int argc, char** argv) {
     spawn(i);
   }
   for (pid_t pid : workers) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
+  for (pid_t pid : listeners) {
     kill(pid, SIGKILL);
     waitpid(pid, nullptr, 0);
   }
@@ -1930,6 +2456,33 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(sh->ns_visits.load()),
       static_cast<unsigned long long>(sh->ns_probes.load()),
       static_cast<unsigned long long>(isolation_checks));
+  std::printf(
+      "fuzz: liveness: %llu listener processes, %llu entries received on %llu wake-ups by a "
+      "queue and %llu by the wake eventfd; %llu subscriber states checked, the longest wait "
+      "seen %lld ms (bound %lld ms)\n",
+      static_cast<unsigned long long>(listener_spawns),
+      static_cast<unsigned long long>(sh->listener_entries.load()),
+      static_cast<unsigned long long>(sh->queue_wakes.load()),
+      static_cast<unsigned long long>(sh->eventfd_wakes.load()),
+      static_cast<unsigned long long>(liveness_checks),
+      static_cast<long long>(
+          std::chrono::duration_cast<std::chrono::milliseconds>(longest_wait).count()),
+      static_cast<long long>(kLivenessBound.count()));
+  std::printf(
+      "fuzz: notifications to listeners: %llu sent, %llu left unsent and reported, %llu left "
+      "unsent silently, %llu reported after a failed mq_open or mq_send; %llu queues unlinked "
+      "under their listener, %llu others made under a listener's queue name\n",
+      static_cast<unsigned long long>(sh->sent.load()),
+      static_cast<unsigned long long>(sh->unsent_reported.load()),
+      static_cast<unsigned long long>(sh->unsent_silent.load()),
+      static_cast<unsigned long long>(sh->send_failed.load()),
+      static_cast<unsigned long long>(sh->unlinked.load()),
+      static_cast<unsigned long long>(sh->replaced.load()));
+  std::printf("fuzz: processes killed on the message path:");
+  for (int k = 0; k < kKillPoints; k++)
+    std::printf("%s %s %llu", k ? "," : "", kKillPointNames[k],
+                static_cast<unsigned long long>(sh->kills[k].load()));
+  std::printf("\n");
   std::printf("fuzz: agnocastd: %llu SIGHUPs, %llu reloads applied, %llu refused\n",
               static_cast<unsigned long long>(daemon.sighups),
               static_cast<unsigned long long>(reloads),
@@ -1958,6 +2511,12 @@ int main(int argc, char** argv) {
   }
   if (namespaces && nprocs >= 3 && !sh->ns_workers) {
     std::printf("fuzz: FAIL: no worker ran in the second IPC namespace\n");
+    ok = false;
+  }
+  if (!liveness_checks || !sh->eventfd_wakes) {
+    std::printf("fuzz: FAIL: %s\n", !liveness_checks
+                                        ? "no listener's subscriber was checked for liveness"
+                                        : "no wake eventfd ever woke a listener");
     ok = false;
   }
   for (int r = 0; r < kRows; r++) {

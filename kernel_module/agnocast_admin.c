@@ -42,7 +42,13 @@ int agnocast_register_process(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = agnocast_enter_ns_write(&ctx, file_ns);
 	if (ret)
 		goto out_put;
-	if (arg.pool_fd == -1) {
+	/*
+	 * Set once: the watchdog signals it under no lock, so replacing it
+	 * could free it under the timer.
+	 */
+	if (wake && ctx.proc && ctx.proc->wake_eventfd) {
+		ret = -EEXIST;
+	} else if (arg.pool_fd == -1) {
 		if (!ctx.proc) {
 			ctx.proc = agnocast_proc_create(ctx.ns);
 			if (IS_ERR(ctx.proc)) {

@@ -99,13 +99,14 @@ void agnocast_wake_publisher_gone(struct agnocast_proc *proc)
 	}
 }
 
-/* Gives @proc the wake eventfd @wake, and our reference to it. */
+/*
+ * Gives @proc, which has none yet, the wake eventfd @wake and our reference
+ * to it; it stays until the teardown, when no watchdog of the process's
+ * subscribers can run any more.
+ */
 void agnocast_wake_set_eventfd(struct agnocast_proc *proc, struct eventfd_ctx *wake)
 {
-	struct eventfd_ctx *old = xchg(&proc->wake_eventfd, wake);
-
-	if (old)
-		eventfd_ctx_put(old);
+	WRITE_ONCE(proc->wake_eventfd, wake);
 }
 
 /* At teardown, once no subscriber of @proc is left to signal it. */

@@ -128,7 +128,7 @@ struct agnocast_version {
  *            accepted in place of F_SEAL_FUTURE_WRITE)
  *
  * With AGNOCAST_REGISTER_WAKE_EVENTFD in flags, either step also sets the
- * process's wake eventfd to wake_fd (replacing one set before): the module
+ * process's wake eventfd to wake_fd, once for the registration: the module
  * signals it when a notification to one of the process's callback
  * subscribers may have been lost (AGNOCAST_WAKE_ONCE), and the process
  * should then make each of them RECEIVE.  Without the flag wake_fd must be
@@ -136,6 +136,7 @@ struct agnocast_version {
  *
  *   -EBADF   wake_fd is not an open descriptor
  *   -EINVAL  wake_fd is not an eventfd
+ *   -EEXIST  the process has a wake eventfd already
  */
 #define AGNOCAST_POOL_SEALS \
 	(0x0002 /* F_SEAL_SHRINK */ | 0x0004 /* F_SEAL_GROW */ | \

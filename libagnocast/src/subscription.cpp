@@ -379,10 +379,20 @@ std::size_t SubscriptionBase::handle_wakeup() {
   // this receive missed has a notification still to come, or one still
   // queued (a queue refuses one only while full, and it holds two at least):
   // either wakes us again.  A queue that holds one only (fs.mqueue.msg_max
-  // 1) is drained first instead.  A throwing callback leaves the
-  // notification queued, for the entries it did not reach.
+  // 1) is drained first instead.  A throwing callback, or a failing receive,
+  // leaves the notification queued, for the entries it did not reach: the
+  // module counts even a failed RECEIVE as looking, so nothing else would
+  // wake us for them.
   const bool drain_after = state.queue->drains_after();
-  if (!drain_after) state.queue->take_one();
+  struct Requeue {
+    const OwnedQueue& queue;
+    const int exceptions = std::uncaught_exceptions();
+    bool taken = false;
+    ~Requeue() {
+      if (taken && std::uncaught_exceptions() > exceptions) queue.notify();
+    }
+  } requeue{*state.queue};
+  if (!drain_after) requeue.taken = state.queue->take_one();
   SubscriberEndpoint::ReleaseBatch releases;
   SubscriberEndpoint& endpoint = *state.endpoint;
   std::size_t release_count = endpoint.begin_wakeup(releases);

@@ -712,12 +712,11 @@ TEST_F(Faults, SubscriberOutOfDescriptors) {
 }
 
 // 3. The same with a queue of one slot (fs.mqueue.msg_max 1), which the
-// subscriber drains before it receives.  Disabled: it fails.  The
-// subscriber takes the one notification before its RECEIVE
-// (libagnocast/src/subscription.cpp, handle_wakeup()), the RECEIVE fails with
-// EMFILE after the module counted it as looking (no watchdog then), and
-// nothing queues the wake-up again: the messages wait for the next PUBLISH.
-TEST_F(Faults, DISABLED_SubscriberOutOfDescriptorsWithOneSlotQueue) {
+// subscriber drains before it receives: the RECEIVE fails with EMFILE after
+// the module counted it as looking (no watchdog then), so the wake-up taken
+// must be queued again (handle_wakeup() in libagnocast/src/subscription.cpp),
+// or the messages wait for the next PUBLISH.
+TEST_F(Faults, SubscriberOutOfDescriptorsWithOneSlotQueue) {
   const MsgMax msg_max(1);
   start_subscriber(0, 16, SubscriberFault::exhaust_descriptors);
   start_publisher(0, 16, 0);

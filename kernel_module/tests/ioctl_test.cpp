@@ -37,6 +37,7 @@ static_assert(sizeof(agnocast_shed) == 8);
 static_assert(sizeof(agnocast_principal) == 8);
 static_assert(sizeof(agnocast_policy_rule) == 280);
 static_assert(sizeof(agnocast_policy) == 32);
+static_assert(sizeof(agnocast_notify_failed) == 16);
 
 void* const kBadPtr = reinterpret_cast<void*>(8);
 
@@ -213,6 +214,47 @@ TEST_F(Device, EndpointCommandsNeedRegistration) {
   auto take = poisoned_request<agnocast_take>();
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_TAKE, &take), -ESRCH);
   EXPECT_EQ(release(dev, {1, 0}, 0), -ESRCH);
+}
+
+// NOTIFY_FAILED's arguments, each refusal with the errno the UAPI header names.
+TEST_F(Device, NotifyFailedErrors) {
+  const auto notify_failed = [&](Endpoint pub, uint32_t subscriber_id, uint32_t reserved = 0) {
+    auto arg = poisoned<agnocast_notify_failed>();
+    arg.topic_handle = pub.handle;
+    arg.publisher_id = pub.id;
+    arg.subscriber_id = subscriber_id;
+    arg.reserved = reserved;
+    return ioc(dev, AGNOCAST_IOC_NOTIFY_FAILED, &arg);
+  };
+  EXPECT_EQ(notify_failed({1, 0}, 1), -ESRCH);
+  registered();
+  Endpoint pub, sub, gone;
+  ASSERT_EQ(add_publisher(dev, "/nf", 1, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/nf", 1, &sub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/nf", 1, &gone), 0);
+  agnocast_remove_endpoint rm{gone.handle, gone.id};
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REMOVE_SUBSCRIBER, &rm), 0);
+
+  EXPECT_EQ(notify_failed(pub, sub.id), 0);
+  EXPECT_EQ(notify_failed(pub, sub.id, 1), -EINVAL);
+  EXPECT_EQ(notify_failed({pub.handle, pub.id + 5}, sub.id), -ENOENT);
+  EXPECT_EQ(notify_failed({pub.handle + 1000, pub.id}, sub.id), -ENOENT);
+  EXPECT_EQ(notify_failed({sub.handle, sub.id}, sub.id), -ENOENT);  // not a publisher
+  EXPECT_EQ(notify_failed(pub, gone.id), -ENOENT);
+  EXPECT_EQ(notify_failed(pub, pub.id), -ENOENT);  // not a subscriber
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_NOTIFY_FAILED, static_cast<agnocast_notify_failed*>(kBadPtr)),
+            -EFAULT);
+  EXPECT_EQ(in_child([&] {
+              Registration other;
+              if (other.full(open_device())) return 10;
+              auto arg = poisoned<agnocast_notify_failed>();
+              arg.topic_handle = pub.handle;
+              arg.publisher_id = pub.id;
+              arg.subscriber_id = sub.id;
+              arg.reserved = 0;
+              return ioc(other.dev, AGNOCAST_IOC_NOTIFY_FAILED, &arg) == -EPERM ? 0 : 11;
+            }),
+            0);
 }
 
 TEST_F(Device, AddEndpointsShareIdsPerTopic) {

@@ -139,7 +139,7 @@ FakeKernel::Subscriber& FakeKernel::subscriber_of(EndpointId endpoint) {
 
 EndpointId FakeKernel::add_publisher(const EndpointRequest& request) {
   std::lock_guard lock(mutex_);
-  if (request.polling) fail("ADD_PUBLISHER", EINVAL);
+  if (request.polling || request.ignore_local || request.wake_once) fail("ADD_PUBLISHER", EINVAL);
   const std::uint32_t handle = join(request);
   Topic& topic = topics_[handle];
   const std::uint32_t id = next_id_++;
@@ -153,6 +153,7 @@ EndpointId FakeKernel::add_publisher(const EndpointRequest& request) {
 
 EndpointId FakeKernel::add_subscriber(const EndpointRequest& request) {
   std::lock_guard lock(mutex_);
+  if (request.polling && request.wake_once) fail("ADD_SUBSCRIBER", EINVAL);
   const std::uint32_t handle = join(request);
   Topic& topic = topics_[handle];
   const std::uint32_t id = next_id_++;
@@ -242,11 +243,13 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
   Topic& topic = topic_of(publisher_id);
   const auto found = topic.publishers.find(publisher_id.id);
   if (found == topic.publishers.end()) fail("PUBLISH", ENOENT);
+  if (found->second.pid != caller_pid_) fail("PUBLISH", EPERM);
   Publisher& publisher = found->second;
   if (wake_ids.size() < topic.subscribers.size()) fail("PUBLISH", ENOBUFS);
 
   const std::uint64_t entry_id = next_entry_id_++;
-  entries_[entry_id] = Entry{addr, publisher_id.id, caller_pid_, true, 0, 0};
+  entries_[entry_id] =
+      Entry{addr, publisher_id.topic_handle, publisher_id.id, caller_pid_, true, 0, 0};
   ++publisher.published;
   publisher.published_bytes += bytes;
   PublishResult result;
@@ -398,6 +401,9 @@ bool FakeKernel::topic_info(const std::string& name, TopicInfo& info) {
     info.name = name;
     info.type_name = topic.type_name;
     info.type_hash = topic.type_hash;
+    info.entries = static_cast<std::uint32_t>(
+        std::count_if(entries_.begin(), entries_.end(),
+                      [&](const auto& entry) { return entry.second.topic_handle == handle; }));
     for (const auto& [id, publisher] : topic.publishers) {
       info.publishers.push_back(
           PublisherInfo{id, publisher.pid, publisher.node, publisher.depth,

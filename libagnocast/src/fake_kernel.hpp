@@ -76,6 +76,7 @@ class FakeKernel final : public Kernel {
  private:
   struct Entry {
     std::uint64_t addr = 0;
+    std::uint32_t topic_handle = 0;
     std::uint32_t publisher_id = 0;
     pid_t pid = 0;
     bool in_window = true;

@@ -39,24 +39,32 @@ void FakeKernel::promise(Subscriber& subscriber) {
   if (!subscriber.notified) {
     subscriber.notified = true;
     subscriber.notified_at = std::chrono::steady_clock::now();
+    subscriber.watchdog_fired = false;
   }
   subscriber.notifier = caller_pid_;
 }
 
-void FakeKernel::break_promise(Subscriber& subscriber) {
-  subscriber.notified = false;
-  if (const auto found = wake_fds_.find(subscriber.pid); found != wake_fds_.end()) {
+void FakeKernel::signal_wake(pid_t pid) {
+  if (const auto found = wake_fds_.find(pid); found != wake_fds_.end()) {
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t written = ::write(found->second, &one, sizeof one);
   }
+}
+
+void FakeKernel::break_promise(Subscriber& subscriber) {
+  subscriber.notified = false;
+  signal_wake(subscriber.pid);
 }
 
 void FakeKernel::break_overdue_promises() {
   const auto now = std::chrono::steady_clock::now();
   for (auto& [handle, topic] : topics_) {
     for (auto& [id, subscriber] : topic.subscribers) {
-      if (subscriber.notified && now - subscriber.notified_at >= watchdog_period) {
-        break_promise(subscriber);
+      if (subscriber.notified && !subscriber.watchdog_fired &&
+          now - subscriber.notified_at >= watchdog_period) {
+        // Signals once per listing and lists nothing again, as the module's watchdog.
+        subscriber.watchdog_fired = true;
+        signal_wake(subscriber.pid);
       }
     }
   }
@@ -245,7 +253,11 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
   if (found == topic.publishers.end()) fail("PUBLISH", ENOENT);
   if (found->second.pid != caller_pid_) fail("PUBLISH", EPERM);
   Publisher& publisher = found->second;
-  if (wake_ids.size() < topic.subscribers.size()) fail("PUBLISH", ENOBUFS);
+  // Room for every callback subscriber, as the module asks: polling ones are never woken.
+  const auto callback_subscribers =
+      std::count_if(topic.subscribers.begin(), topic.subscribers.end(),
+                    [](const auto& entry) { return !entry.second.polling; });
+  if (wake_ids.size() < static_cast<std::size_t>(callback_subscribers)) fail("PUBLISH", ENOBUFS);
 
   const std::uint64_t entry_id = next_entry_id_++;
   entries_[entry_id] =

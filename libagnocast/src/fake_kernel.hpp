@@ -68,8 +68,10 @@ class FakeKernel final : public Kernel {
   // The process dies, as the module's teardown sees it: the promises it made
   // break, then its endpoints go.
   void end_process(pid_t pid);
-  // What the module's watchdog does on its own: breaks the promises not kept
-  // within the watchdog period (AGNOCAST_WAKE_WATCHDOG_MS). Every call runs it too.
+  // What the module's watchdog does on its own: signals the wake eventfd of
+  // a subscriber that has not looked within the watchdog period
+  // (AGNOCAST_WAKE_WATCHDOG_MS) of its listing, once per listing, without
+  // listing it again. Every call runs it too.
   void run_watchdog();
   static constexpr std::chrono::milliseconds watchdog_period{50};
 
@@ -105,6 +107,7 @@ class FakeKernel final : public Kernel {
     bool notified = false;
     std::chrono::steady_clock::time_point notified_at;
     pid_t notifier = 0;
+    bool watchdog_fired = false;  // signalled for this listing already
     std::deque<std::uint64_t> unreceived;
     std::multiset<std::uint64_t> held;
     std::uint64_t received = 0;
@@ -125,6 +128,7 @@ class FakeKernel final : public Kernel {
   // The module's wake rules (kernel_module/agnocast_wake.c), mutex_ held.
   void promise(Subscriber& subscriber);
   void break_promise(Subscriber& subscriber);
+  void signal_wake(pid_t pid);
   void break_overdue_promises();
   void remove_subscriber_locked(Topic& topic, std::uint32_t id);
   void remove_publisher_locked(Topic& topic, std::uint32_t id);

@@ -27,16 +27,24 @@ void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
 TEST_F(PublisherTest, GrowsItsWakeSlotsUntilEverySubscriberIsWoken) {
   Node node{"growth"};
   const std::string name = topic("growth");
-  std::vector<std::shared_ptr<PollingSubscriber<Counted>>> subscribers;
-  for (int i = 0; i < 40; ++i) {
-    subscribers.push_back(node.create_polling_subscriber<Counted>(name, QoS{1}));
+  std::vector<std::uint64_t> seen(40, 0);
+  std::vector<std::shared_ptr<Subscription<Counted>>> subscriptions;
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    subscriptions.push_back(node.create_subscription<Counted>(
+        name, QoS{1}, [&seen, i](const ipc_shared_ptr<const Counted>& m) { seen[i] = m->seq; }));
   }
+  // Polling subscribers are never woken: they need no slot.
+  std::vector<std::shared_ptr<PollingSubscriber<Counted>>> polling;
+  for (int i = 0; i < 40; ++i)
+    polling.push_back(node.create_polling_subscriber<Counted>(name, QoS{1}));
   auto publisher = node.create_publisher<Counted>(name, QoS{1});
 
   publish(*publisher, 1);
   // 16 slots refused (ENOBUFS), then 32, then 64 accepted.
   EXPECT_EQ(kernel().calls().publish, 3);
-  for (auto& subscriber : subscribers) {
+  for (auto& subscription : subscriptions) EXPECT_EQ(subscription->handle_wakeup(), 1U);
+  for (const std::uint64_t seq : seen) EXPECT_EQ(seq, 1U);
+  for (auto& subscriber : polling) {
     const auto message = subscriber->take_data();
     ASSERT_TRUE(message);
     EXPECT_EQ(message->seq, 1U);

@@ -2,6 +2,7 @@
 // with outputs poisoned before the call and checked after.
 #include <poll.h>
 #include <sched.h>
+#include <sys/eventfd.h>
 #include <sys/prctl.h>
 
 #include <algorithm>
@@ -1389,6 +1390,33 @@ TEST_F(Device, ReceiveIntoABufferEndingReadOnlyReceivesNothing) {
   EXPECT_EQ(arg.entry_count, 1u);
   EXPECT_EQ(unreceived_held(dev, "/ro"), std::make_pair(0u, 1u));
   munmap(area, 2 * page);
+}
+
+// The watchdog signals a process's wake eventfd under no lock: once set, it
+// is never replaced, so it cannot be freed under the timer.
+TEST_F(Device, WakeEventfdIsSetOnce) {
+  const int first = eventfd(0, EFD_CLOEXEC), second = eventfd(0, EFD_CLOEXEC);
+  ASSERT_GE(first, 0);
+  ASSERT_GE(second, 0);
+  agnocast_register_process r{};
+  r.pool_fd = -1;
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);  // none yet
+  // TearDown unregisters.
+  reg.dev = dev;
+  r = {};
+  r.pool_fd = -1;
+  r.flags = AGNOCAST_REGISTER_WAKE_EVENTFD;
+  r.wake_fd = first;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0);  // given on a repeat
+  r.wake_fd = second;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EEXIST);
+  r.wake_fd = first;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), -EEXIST);
+  r = {};
+  r.pool_fd = -1;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &r), 0) << "a repeat without one still works";
+  close(first);
+  close(second);
 }
 
 TEST_F(Device, RequestFlagsAndReservedMustBeZero) {

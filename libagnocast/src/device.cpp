@@ -303,15 +303,16 @@ Version Device::get_version() const {
 PoolSlot Device::register_process(int pool_fd) {
   agnocast_register_process argument{};
   argument.pool_fd = pool_fd;
+  // The module takes a wake eventfd once: give it with the first step only.
   if (pool_fd == -1 && wake_fd_ < 0) {
     wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
-    if (wake_fd_ < 0) fail("eventfd for the wake-up's safety net", errno);
-  }
-  if (pool_fd == -1) {
+    if (wake_fd_ < 0) fail("eventfd for the module's wake-ups", errno);
     argument.flags = AGNOCAST_REGISTER_WAKE_EVENTFD;
     argument.wake_fd = wake_fd_;
   }
   if (int err = call(fd_, AGNOCAST_IOC_REGISTER_PROCESS, &argument)) {
+    // Not taken: the next first step gives a new one.
+    if (argument.flags & AGNOCAST_REGISTER_WAKE_EVENTFD) ::close(std::exchange(wake_fd_, -1));
     switch (err) {
       case ENOSPC:
         fail("REGISTER_PROCESS", err,

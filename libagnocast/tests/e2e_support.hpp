@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <agnocast/agnocast.hpp>
+#include <agnocast_test/process.hpp>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
@@ -51,24 +52,7 @@ class Pipe {
   int fds_[2];
 };
 
-// Runs body in a forked child; its return value is the child's exit code.
-// A throwing body exits 99 after printing why.
-inline pid_t fork_child(const std::function<int()>& body) {
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    int code = 98;
-    try {
-      code = body();
-    } catch (const std::exception& error) {
-      std::fprintf(stderr, "child %d: %s\n", ::getpid(), error.what());
-      code = 99;
-    }
-    std::fflush(nullptr);
-    ::_exit(code);
-  }
-  return pid;
-}
+using agnocast_test::fork_child;
 
 // The child's wait status; kills it after timeout.
 inline int wait_child(pid_t pid, std::chrono::seconds timeout = 120s) {

@@ -121,23 +121,7 @@ bool descriptors_exhausted() {
   return fd < 0 && errno == EMFILE;
 }
 
-// Runs body in a forked child; its return value is the child's exit code.
-pid_t fork_child(const std::function<int()>& body) {
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    int code = 98;
-    try {
-      code = body();
-    } catch (const std::exception& error) {
-      std::fprintf(stderr, "child %d: %s\n", ::getpid(), error.what());
-      code = 99;
-    }
-    std::fflush(nullptr);
-    ::_exit(code);
-  }
-  return pid;
-}
+using agnocast_test::fork_child;
 
 // The child's exit status (128 + signal); kills it after limit.
 int wait_child(pid_t pid, std::chrono::milliseconds limit) {

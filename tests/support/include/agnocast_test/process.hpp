@@ -11,6 +11,8 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <exception>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -105,6 +107,25 @@ inline Outcome run_shell(const std::string& command, const std::string& stem,
   int status = 0;
   ::waitpid(pid, &status, 0);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+// Runs body in a forked child, not waited for: its exit status is what body
+// returns, 99 when it throws (after printing why).
+inline pid_t fork_child(const std::function<int()>& body) {
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    int code = 98;
+    try {
+      code = body();
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "child %d: %s\n", ::getpid(), error.what());
+      code = 99;
+    }
+    std::fflush(nullptr);
+    ::_exit(code);
+  }
+  return pid;
 }
 
 // Runs fn in a forked child, whose exit status is what fn returns; that

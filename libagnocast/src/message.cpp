@@ -58,6 +58,10 @@ void stamp_publication(void* message, std::uint64_t bytes) noexcept {
   header.published_bytes = bytes;
 }
 
+std::span<const std::byte> pool_holding(const void* address) {
+  return Runtime::get().pool_holding(address);
+}
+
 Publication read_publication(const void* message, const void* pool_begin,
                              std::size_t pool_size) noexcept {
   const auto at = reinterpret_cast<std::uintptr_t>(message);

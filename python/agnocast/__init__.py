@@ -21,6 +21,7 @@ from ._core import (  # noqa: F401  (re-exported)
     DeviceError,
     Error,
     Executor,
+    InvalidMessage,
     MessagePublished,
     MessageType,
     ModuleNotLoaded,

@@ -9,45 +9,6 @@
 namespace agnocast::python {
 namespace {
 
-// Where agnocast::vector keeps its three pointers. The schema's container
-// layout names begin and end; the capacity end is the remaining word, found
-// once from a vector of this standard library.
-struct VectorWords {
-  std::size_t begin;
-  std::size_t end;
-  std::size_t capacity;
-};
-
-const VectorWords& vector_words() {
-  static const VectorWords words = [] {
-    static_assert(sizeof(std::vector<std::uint64_t>) == 3 * sizeof(void*));
-    static_assert(sizeof(agnocast::vector<std::uint64_t>) == sizeof(std::vector<std::uint64_t>));
-    std::vector<std::uint64_t> probe;
-    probe.reserve(8);
-    probe.resize(3);
-    const std::uint64_t* data = probe.data();
-    void* expected[3] = {const_cast<std::uint64_t*>(data), const_cast<std::uint64_t*>(data + 3),
-                         const_cast<std::uint64_t*>(data + 8)};
-    VectorWords found{~std::size_t{0}, ~std::size_t{0}, ~std::size_t{0}};
-    std::size_t* slots[3] = {&found.begin, &found.end, &found.capacity};
-    for (std::size_t word = 0; word < 3; ++word) {
-      void* value;
-      std::memcpy(&value, reinterpret_cast<const std::byte*>(&probe) + word * sizeof(void*),
-                  sizeof(void*));
-      for (int which = 0; which < 3; ++which) {
-        if (value == expected[which]) *slots[which] = word * sizeof(void*);
-      }
-    }
-    const ContainerLayout& native = native_container_layout();
-    if (found.begin != native.vector_begin_offset || found.end != native.vector_end_offset ||
-        found.capacity >= sizeof(probe)) {
-      throw SchemaError("agnocast: this standard library's std::vector layout is not supported");
-    }
-    return found;
-  }();
-  return words;
-}
-
 std::byte* read_pointer(const void* vector, std::size_t offset) {
   std::byte* value;
   std::memcpy(&value, static_cast<const std::byte*>(vector) + offset, sizeof(value));
@@ -56,14 +17,6 @@ std::byte* read_pointer(const void* vector, std::size_t offset) {
 
 void write_pointer(void* vector, std::size_t offset, std::byte* value) {
   std::memcpy(static_cast<std::byte*>(vector) + offset, &value, sizeof(value));
-}
-
-bool same_layout(const ContainerLayout& a, const ContainerLayout& b) {
-  return a.pointer_size == b.pointer_size && a.vector_size == b.vector_size &&
-         a.vector_begin_offset == b.vector_begin_offset &&
-         a.vector_end_offset == b.vector_end_offset && a.string_size == b.string_size &&
-         a.string_data_offset == b.string_data_offset &&
-         a.string_length_offset == b.string_length_offset;
 }
 
 }  // namespace
@@ -94,12 +47,7 @@ bool is_primitive(FieldKind kind) { return primitive_size(kind) != 0; }
 
 ErasedSchema::ErasedSchema(std::vector<std::uint8_t> blob)
     : blob_(std::move(blob)), schema_(parse_schema(blob_)) {
-  if (!same_layout(schema_.containers, native_container_layout())) {
-    throw SchemaError(
-        "agnocast: the message type was generated with another standard library's containers "
-        "than this Python module's");
-  }
-  vector_words();  // fails here, not in the middle of a message, if unsupported
+  require_native_layout(schema_.containers, schema_.types[0].name, "the Python binding");
   names_.resize(schema_.types.size());
   for (std::size_t t = 0; t < schema_.types.size(); ++t) {
     const auto& fields = schema_.types[t].fields;
@@ -187,31 +135,35 @@ void ErasedOps::destroy(void* message, std::uint16_t index) const noexcept {
   }
 }
 
-VectorSpan ErasedOps::sequence(const void* field_address, const SchemaField& field) const {
-  const VectorWords& words = vector_words();
-  std::byte* begin = read_pointer(field_address, words.begin);
-  std::byte* end = read_pointer(field_address, words.end);
-  const std::size_t count = begin ? static_cast<std::size_t>(end - begin) / field.element_size : 0;
-  return {begin, count};
+VectorSpan ErasedOps::sequence(const void* field_address, const SchemaField& field,
+                               const ForeignMemory& memory) const {
+  const ForeignElements found = field_elements(
+      schema_.schema().containers, field, static_cast<const std::byte*>(field_address), memory);
+  if (found.problem) {
+    throw InvalidMessage("agnocast: field '" + field.name +
+                         "' of a received message: " + found.problem);
+  }
+  // Writable only where the message is this process's loan (the caller's to know).
+  return {const_cast<std::byte*>(found.first), found.count};
 }
 
 void ErasedOps::resize_sequence(void* field_address, const SchemaField& field,
                                 std::size_t count) const {
-  const VectorWords& words = vector_words();
+  const NativeContainerWords& words = native_container_words();
   const std::size_t size = field.element_size;
-  std::byte* begin = read_pointer(field_address, words.begin);
-  std::byte* end = read_pointer(field_address, words.end);
-  std::byte* capacity_end = read_pointer(field_address, words.capacity);
+  std::byte* begin = read_pointer(field_address, words.layout.vector_begin_offset);
+  std::byte* end = read_pointer(field_address, words.layout.vector_end_offset);
+  std::byte* capacity_end = read_pointer(field_address, words.vector_capacity_offset);
   const std::size_t current = begin ? static_cast<std::size_t>(end - begin) / size : 0;
   const std::size_t capacity = begin ? static_cast<std::size_t>(capacity_end - begin) / size : 0;
   if (count <= current) {
     destroy_elements(begin + count * size, field, current - count);
-    if (begin) write_pointer(field_address, words.end, begin + count * size);
+    if (begin) write_pointer(field_address, words.layout.vector_end_offset, begin + count * size);
     return;
   }
   if (count <= capacity) {
     construct_elements(end, field, count - current);
-    write_pointer(field_address, words.end, begin + count * size);
+    write_pointer(field_address, words.layout.vector_end_offset, begin + count * size);
     return;
   }
   if (count > (std::size_t{1} << 40) / size) throw std::bad_array_new_length();
@@ -223,7 +175,7 @@ void ErasedOps::resize_sequence(void* field_address, const SchemaField& field,
     try {
       for (std::size_t i = 0; i < current; ++i) {
         if (field.kind == FieldKind::String) {
-          assign_string(fresh + i * size, string_at(begin + i * size));
+          assign_string(fresh + i * size, string_at(begin + i * size, field));
         } else {
           copy(fresh + i * size, begin + i * size, field.nested);
         }
@@ -236,23 +188,30 @@ void ErasedOps::resize_sequence(void* field_address, const SchemaField& field,
   }
   destroy_elements(begin, field, current);
   if (begin) detail::pool_deallocate(begin);
-  write_pointer(field_address, words.begin, fresh);
-  write_pointer(field_address, words.end, fresh + count * size);
-  write_pointer(field_address, words.capacity, fresh + count * size);
+  write_pointer(field_address, words.layout.vector_begin_offset, fresh);
+  write_pointer(field_address, words.layout.vector_end_offset, fresh + count * size);
+  write_pointer(field_address, words.vector_capacity_offset, fresh + count * size);
 }
 
-std::string_view ErasedOps::string_at(const void* address) const {
-  const auto* text = std::launder(reinterpret_cast<const agnocast::string*>(address));
-  return {text->data(), text->size()};
+std::string_view ErasedOps::string_at(const void* address, const SchemaField& field,
+                                      const ForeignMemory& memory) const {
+  const ForeignText found = string_text(schema_.schema().containers, field,
+                                        static_cast<const std::byte*>(address), memory);
+  if (found.problem) {
+    throw InvalidMessage("agnocast: field '" + field.name +
+                         "' of a received message: " + found.problem);
+  }
+  return found.text;
 }
 
 void ErasedOps::assign_string(void* address, std::string_view text) const {
   std::launder(reinterpret_cast<agnocast::string*>(address))->assign(text.data(), text.size());
 }
 
-void ErasedOps::copy_field(std::byte* to, const std::byte* from, const SchemaField& field) const {
+void ErasedOps::copy_field(std::byte* to, const std::byte* from, const SchemaField& field,
+                           const ForeignMemory& from_memory) const {
   if (field.shape == FieldShape::Sequence) {
-    const VectorSpan source = sequence(from, field);
+    const VectorSpan source = sequence(from, field, from_memory);
     resize_sequence(to, field, source.count);
     const VectorSpan target = sequence(to, field);
     if (is_primitive(field.kind)) {
@@ -262,9 +221,9 @@ void ErasedOps::copy_field(std::byte* to, const std::byte* from, const SchemaFie
     for (std::size_t i = 0; i < source.count; ++i) {
       const std::size_t at = i * field.element_size;
       if (field.kind == FieldKind::String) {
-        assign_string(target.data + at, string_at(source.data + at));
+        assign_string(target.data + at, string_at(source.data + at, field, from_memory));
       } else {
-        copy(target.data + at, source.data + at, field.nested);
+        copy(target.data + at, source.data + at, field.nested, from_memory);
       }
     }
     return;
@@ -277,18 +236,19 @@ void ErasedOps::copy_field(std::byte* to, const std::byte* from, const SchemaFie
   for (std::size_t i = 0; i < count; ++i) {
     const std::size_t at = i * field.element_size;
     if (field.kind == FieldKind::String) {
-      assign_string(to + at, string_at(from + at));
+      assign_string(to + at, string_at(from + at, field, from_memory));
     } else {
-      copy(to + at, from + at, field.nested);
+      copy(to + at, from + at, field.nested, from_memory);
     }
   }
 }
 
-void ErasedOps::copy(void* to, const void* from, std::uint16_t index) const {
+void ErasedOps::copy(void* to, const void* from, std::uint16_t index,
+                     const ForeignMemory& from_memory) const {
   if (to == from) return;
   for (const SchemaField& field : schema_.type(index).fields) {
     copy_field(static_cast<std::byte*>(to) + field.offset,
-               static_cast<const std::byte*>(from) + field.offset, field);
+               static_cast<const std::byte*>(from) + field.offset, field, from_memory);
   }
 }
 

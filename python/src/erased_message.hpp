@@ -15,7 +15,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include "agnocast/errors.hpp"
 #include "agnocast/schema.hpp"
+#include "agnocast/schema_walk.hpp"
 
 namespace agnocast::python {
 
@@ -38,13 +40,24 @@ class ErasedSchema {
   std::vector<std::unordered_map<std::string, std::size_t>> names_;
 };
 
+// A received message whose containers point where they must not (outside the
+// publisher's pool, misaligned, longer than their bound): raised naming the
+// field, instead of reading there.
+class InvalidMessage : public Error {
+ public:
+  using Error::Error;
+};
+
 // The bytes of an agnocast::vector<T> whose element size the schema gives.
 struct VectorSpan {
   std::byte* data;
   std::size_t count;
 };
 
-// Operations on a message of type `index` at `message`, memory the caller owns.
+// Operations on a message of type `index` at `message`. Writes need memory the
+// caller owns; reads take the memory they may touch (trusted by default: a
+// message this process built) and throw InvalidMessage where the message
+// points outside it.
 class ErasedOps {
  public:
   explicit ErasedOps(const ErasedSchema& schema) : schema_(schema) {}
@@ -53,22 +66,27 @@ class ErasedOps {
   void construct(void* message, std::uint16_t index) const;
   // Destroys it: frees every vector's and string's pool memory.
   void destroy(void* message, std::uint16_t index) const noexcept;
-  // Deep copy of one message of the type onto another (both constructed).
-  void copy(void* to, const void* from, std::uint16_t index) const;
+  // Deep copy of one message of the type onto another (both constructed);
+  // `from` may be a received message within from_memory.
+  void copy(void* to, const void* from, std::uint16_t index,
+            const ForeignMemory& from_memory = {}) const;
 
   // A Sequence field's elements, in place.
-  VectorSpan sequence(const void* field_address, const SchemaField& field) const;
+  VectorSpan sequence(const void* field_address, const SchemaField& field,
+                      const ForeignMemory& memory = {}) const;
   // Resizes a Sequence field: new elements are default-constructed (zero).
   void resize_sequence(void* field_address, const SchemaField& field, std::size_t count) const;
 
   // A String element (a field, an array element or a sequence element).
-  std::string_view string_at(const void* address) const;
+  std::string_view string_at(const void* address, const SchemaField& field,
+                             const ForeignMemory& memory = {}) const;
   void assign_string(void* address, std::string_view text) const;
 
  private:
   void construct_elements(std::byte* at, const SchemaField& field, std::size_t count) const;
   void destroy_elements(std::byte* at, const SchemaField& field, std::size_t count) const noexcept;
-  void copy_field(std::byte* to, const std::byte* from, const SchemaField& field) const;
+  void copy_field(std::byte* to, const std::byte* from, const SchemaField& field,
+                  const ForeignMemory& from_memory) const;
 
   const ErasedSchema& schema_;
 };

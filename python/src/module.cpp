@@ -141,6 +141,10 @@ struct Storage {
   bool loan = false;
   bool published = false;
   detail::EntryReference* reference = nullptr;
+  // What a read may touch: everything for a loan, the publisher's pool for a
+  // received message, whose every pointer is the publisher's to write.
+  ForeignMemory memory;
+  const char* problem = nullptr;  // a received message that is not where it must be
 
   ~Storage() {
     if (reference) {
@@ -154,6 +158,9 @@ struct Storage {
       throw MessagePublished(
           "agnocast: this message was published; borrow a new one with "
           "borrow_loaned_message()");
+    }
+    if (problem) {
+      throw InvalidMessage("agnocast: a received " + cls->schema.type(0).name + ": " + problem);
     }
   }
 };
@@ -238,7 +245,8 @@ struct Sequence {
   const ErasedOps& ops() const { return storage->cls->ops; }
   VectorSpan elements() const {
     storage->check();
-    if (field->shape == FieldShape::Sequence) return ops().sequence(address, *field);
+    if (field->shape == FieldShape::Sequence)
+      return ops().sequence(address, *field, storage->memory);
     return {address, field->array_length};
   }
   std::size_t length() const { return elements().count; }
@@ -438,7 +446,7 @@ py::object field_value(const std::shared_ptr<Storage>& storage, std::byte* base,
   std::byte* at = base + field.offset;
   const ErasedOps& ops = storage->cls->ops;
   if (field.shape == FieldShape::Single) {
-    if (field.kind == FieldKind::String) return decode(ops.string_at(at));
+    if (field.kind == FieldKind::String) return decode(ops.string_at(at, field, storage->memory));
     if (field.kind == FieldKind::Message) return to_python(Message{storage, at, field.nested});
     return read_number(at, field.kind);
   }
@@ -450,6 +458,23 @@ py::object field_value(const std::shared_ptr<Storage>& storage, std::byte* base,
 
 void assign_numbers(const Sequence& sequence, py::handle value) {
   const SchemaField& field = *sequence.field;
+  if (py::isinstance<Sequence>(value)) {
+    // Another message's numbers, read through its checks (numpy would hide
+    // their error behind its own).
+    const auto& from = py::cast<const Sequence&>(value);
+    if (from.field->kind == field.kind) {
+      const VectorSpan source = from.elements();
+      if (field.shape == FieldShape::Sequence) {
+        sequence.resize(source.count);
+      } else if (source.count != field.array_length) {
+        throw py::value_error("agnocast: field '" + field.name + "' holds exactly " +
+                              std::to_string(field.array_length) + " elements");
+      }
+      const VectorSpan target = sequence.elements();
+      if (source.count) std::memmove(target.data, source.data, source.count * field.element_size);
+      return;
+    }
+  }
   py::array source = py::array::ensure(value);
   if (!source) throw py::type_error("agnocast: field '" + field.name + "' takes numbers");
   source = py::array(py::module_::import("numpy").attr("ascontiguousarray")(source.attr("ravel")(),
@@ -480,7 +505,7 @@ void set_field(const std::shared_ptr<Storage>& storage, std::byte* base, const S
                              ", not a " + source.type().name);
       }
       // Same layout (the hash says so), possibly described by another schema object.
-      source.storage->cls->ops.copy(at, source.base, source.index);
+      source.storage->cls->ops.copy(at, source.base, source.index, source.storage->memory);
       return;
     }
     return write_number(at, field.kind, value, field.name);
@@ -505,9 +530,81 @@ void set_field(const std::shared_ptr<Storage>& storage, std::byte* base, const S
       if (source.type().hash != storage->cls->schema.type(field.nested).hash) {
         throw py::type_error("agnocast: elements of '" + field.name + "' have another type");
       }
-      source.storage->cls->ops.copy(element, source.base, source.index);
+      source.storage->cls->ops.copy(element, source.base, source.index, source.storage->memory);
     }
   }
+}
+
+// agnocast.InvalidMessage, for the buffer getter (set when the module loads).
+PyObject*& invalid_message_type() {
+  static PyObject* type = nullptr;
+  return type;
+}
+
+// Sets the Python error for the exception being handled.
+void raise_current_exception() {
+  try {
+    throw;
+  } catch (py::error_already_set& error) {
+    error.restore();
+  } catch (const py::builtin_exception& error) {
+    error.set_error();
+  } catch (const InvalidMessage& error) {
+    PyErr_SetString(invalid_message_type(), error.what());
+  } catch (const std::exception& error) {
+    PyErr_SetString(PyExc_RuntimeError, error.what());
+  }
+}
+
+// What a Sequence's buffer view points its format, shape and strides at.
+struct SequenceBuffer {
+  std::string format;
+  py::ssize_t shape;
+  py::ssize_t stride;
+};
+
+// The buffer protocol of a Sequence of numbers (numpy views, memoryview),
+// written out rather than by pybind11's def_buffer, whose getter must not
+// throw: a received sequence pointing outside the publisher's pool raises
+// InvalidMessage here, and the view is made from the words read and checked once.
+extern "C" int sequence_getbuffer(PyObject* object, Py_buffer* view, int flags) {
+  view->obj = nullptr;
+  try {
+    const auto& sequence = py::cast<const Sequence&>(py::handle(object));
+    const SchemaField& field = *sequence.field;
+    if (!is_primitive(field.kind)) {
+      throw py::type_error("agnocast: only fields of numbers are buffers");
+    }
+    if ((flags & PyBUF_WRITABLE) == PyBUF_WRITABLE && !sequence.writable()) {
+      throw py::buffer_error("agnocast: a received message is read-only");
+    }
+    static std::uint64_t empty = 0;
+    const VectorSpan span = sequence.elements();
+    const auto size = static_cast<py::ssize_t>(field.element_size);
+    auto* buffer =
+        new SequenceBuffer{py::str(dtype_of(field.kind).attr("char")).cast<std::string>(),
+                           static_cast<py::ssize_t>(span.count), size};
+    view->buf = span.data ? static_cast<void*>(span.data) : &empty;
+    view->len = buffer->shape * size;
+    view->itemsize = size;
+    view->readonly = sequence.writable() ? 0 : 1;
+    view->ndim = 1;
+    view->format = (flags & PyBUF_FORMAT) == PyBUF_FORMAT ? buffer->format.data() : nullptr;
+    view->shape = (flags & PyBUF_ND) == PyBUF_ND ? &buffer->shape : nullptr;
+    view->strides = (flags & PyBUF_STRIDES) == PyBUF_STRIDES ? &buffer->stride : nullptr;
+    view->suboffsets = nullptr;
+    view->internal = buffer;
+    view->obj = object;
+    Py_INCREF(object);
+    return 0;
+  } catch (...) {
+    raise_current_exception();
+    return -1;
+  }
+}
+
+extern "C" void sequence_releasebuffer(PyObject*, Py_buffer* view) {
+  delete static_cast<SequenceBuffer*>(view->internal);
 }
 
 py::dict info_dict(const MessageInfo& info) {
@@ -524,6 +621,8 @@ Message received(const MessageClass* cls, const void* message, detail::EntryRefe
   storage->cls = cls;
   storage->message = const_cast<void*>(message);
   storage->reference = reference;
+  storage->memory = ForeignMemory(detail::pool_holding(message));
+  storage->problem = message_problem(cls->type(), message, storage->memory);
   return Message{storage, static_cast<std::byte*>(storage->message), 0};
 }
 
@@ -718,6 +817,7 @@ PYBIND11_MODULE(_core, m) {
   static py::exception<QueueError> queue_error(m, "QueueError", error.ptr());
   static py::exception<TopicWithoutSchema> no_schema(m, "TopicWithoutSchema", error.ptr());
   static py::exception<SchemaError> schema_error(m, "SchemaError", error.ptr());
+  static py::exception<InvalidMessage> invalid_message(m, "InvalidMessage", error.ptr());
   static py::exception<PoolExhausted> pool_exhausted(m, "PoolExhausted", error.ptr());
   static py::exception<MessagePublished> message_published(m, "MessagePublished", error.ptr());
   static py::exception<ReadOnlyMessage> read_only(m, "ReadOnlyMessage", error.ptr());
@@ -849,14 +949,15 @@ PYBIND11_MODULE(_core, m) {
 
   core_message_init() = m.attr("Message").attr("__init__");
 
-  py::class_<Sequence>(m, "Sequence", py::buffer_protocol())
-      .def("__len__", &Sequence::length)
+  py::class_<Sequence> sequence_class(m, "Sequence", py::buffer_protocol());
+  sequence_class.def("__len__", &Sequence::length)
       .def("resize", &Sequence::resize, py::arg("count"))
       .def_property_readonly("_writable", &Sequence::writable)
       .def("__getitem__",
            [](const Sequence& s, std::ptrdiff_t i) -> py::object {
              std::byte* at = s.element(i);
-             if (s.field->kind == FieldKind::String) return decode(s.ops().string_at(at));
+             if (s.field->kind == FieldKind::String)
+               return decode(s.ops().string_at(at, *s.field, s.storage->memory));
              if (s.field->kind == FieldKind::Message) {
                return to_python(Message{s.storage, at, s.field->nested});
              }
@@ -886,7 +987,7 @@ PYBIND11_MODULE(_core, m) {
                if (source.type().hash != s.storage->cls->schema.type(s.field->nested).hash) {
                  throw py::type_error("agnocast: the element has another type");
                }
-               source.storage->cls->ops.copy(at, source.base, source.index);
+               source.storage->cls->ops.copy(at, source.base, source.index, source.storage->memory);
              } else {
                write_number(at, s.field->kind, value, s.field->name);
              }
@@ -903,19 +1004,6 @@ PYBIND11_MODULE(_core, m) {
             return view;
           },
           py::arg("dtype") = py::none())
-      .def_buffer([](const Sequence& s) -> py::buffer_info {
-        if (!is_primitive(s.field->kind)) {
-          throw py::type_error("agnocast: only fields of numbers are buffers");
-        }
-        static std::uint64_t empty = 0;
-        const VectorSpan span = s.elements();
-        const py::dtype type = dtype_of(s.field->kind);
-        return py::buffer_info(span.data ? static_cast<void*>(span.data) : &empty,
-                               static_cast<py::ssize_t>(s.field->element_size),
-                               py::str(type.attr("char")).cast<std::string>(), 1,
-                               {static_cast<py::ssize_t>(span.count)},
-                               {static_cast<py::ssize_t>(s.field->element_size)}, !s.writable());
-      })
       .def("__repr__", [](const Sequence& s) {
         if (is_primitive(s.field->kind)) {
           const VectorSpan span = s.elements();
@@ -926,6 +1014,12 @@ PYBIND11_MODULE(_core, m) {
         }
         return "Sequence(" + std::to_string(s.length()) + " elements)";
       });
+
+  // pybind11's buffer getter may not throw; this one raises instead.
+  auto* sequence_type = reinterpret_cast<PyHeapTypeObject*>(sequence_class.ptr());
+  sequence_type->as_buffer.bf_getbuffer = sequence_getbuffer;
+  sequence_type->as_buffer.bf_releasebuffer = sequence_releasebuffer;
+  invalid_message_type() = invalid_message.ptr();
 
   py::enum_<CallbackGroupType>(m, "CallbackGroupType")
       .value("MutuallyExclusive", CallbackGroupType::MutuallyExclusive)

@@ -125,7 +125,8 @@ TEST_F(ErasedMessageTest, BuiltByCppReadsAndCopiesThroughTheSchema) {
   const SchemaField& fields = field(schema, 0, "fields");
   const SchemaField& name = field(schema, fields.nested, "name");
   EXPECT_EQ(ops.string_at(ops.sequence(bytes + fields.offset, fields).data +
-                          2 * fields.element_size + name.offset),
+                              2 * fields.element_size + name.offset,
+                          name),
             "intensity, a name beyond the small-string buffer");
 
   auto* copy = raw_message<sensor_msgs::msg::PointCloud2>();
@@ -147,6 +148,34 @@ TEST_F(ErasedMessageTest, BuiltByCppReadsAndCopiesThroughTheSchema) {
   ops.destroy(copy, 0);
   ops.destroy(cloud, 0);
   detail::pool_deallocate(copy);
+  detail::pool_deallocate(cloud);
+}
+
+TEST_F(ErasedMessageTest, AReceivedMessagesContainersAreReadOnlyWithinItsMemory) {
+  const ErasedSchema schema = schema_for<sensor_msgs::msg::PointCloud2>();
+  const ErasedOps ops(schema);
+  auto* cloud = new (raw_message<sensor_msgs::msg::PointCloud2>()) sensor_msgs::msg::PointCloud2();
+  cloud->header.frame_id = "a frame name beyond the small-string buffer";
+  cloud->data.resize(64);
+  const auto* bytes = reinterpret_cast<const std::byte*>(cloud);
+  // Memory that holds the message but not what its containers point to.
+  const ForeignMemory only_the_message(std::span<const std::byte>(bytes, sizeof(*cloud)));
+  const SchemaField& data = field(schema, 0, "data");
+  EXPECT_EQ(ops.sequence(bytes + data.offset, data).count, 64u);  // trusted: read
+  try {
+    ops.sequence(bytes + data.offset, data, only_the_message);
+    ADD_FAILURE() << "a sequence outside the memory was read";
+  } catch (const InvalidMessage& error) {
+    EXPECT_STREQ(error.what(),
+                 "agnocast: field 'data' of a received message: sequence outside the "
+                 "publisher's pool");
+  }
+  auto* copy = raw_message<sensor_msgs::msg::PointCloud2>();
+  ops.construct(copy, 0);
+  EXPECT_THROW(ops.copy(copy, cloud, 0, only_the_message), InvalidMessage);
+  ops.destroy(copy, 0);
+  detail::pool_deallocate(copy);
+  cloud->~PointCloud2();
   detail::pool_deallocate(cloud);
 }
 

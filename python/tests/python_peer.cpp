@@ -3,14 +3,19 @@
 // Python test can compare (contents, and the pool address of an array).
 //
 // usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]
+//        python_peer hostile cloud TOPIC
 //   pub: waits for a subscriber, then publishes COUNT messages 100 ms apart
 //        (cloud: SIZE bytes of data, byte i = (i + seq) % 251), then waits
 //        for the end of stdin
 //   sub: prints each message until COUNT arrived, exits 0 (1 after 60 s)
+//   hostile: publishes one cloud per way its containers can lie (see
+//        hostile_clouds), printing the fault's name, then waits for stdin
 #include <agnocast/agnocast.hpp>
+#include <agnocast/schema_layout.hpp>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <geometry_msgs/msg/vector3.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
 #include <std_msgs/msg/string.hpp>
@@ -117,11 +122,65 @@ int run(bool publish, const std::string& topic, int count, std::size_t size) {
   return received >= count ? 0 : 1;
 }
 
+// Rewrites the words of a vector or string in place, as a hostile publisher can.
+void write_word(void* container, std::uint8_t offset, std::uintptr_t value) {
+  std::memcpy(static_cast<std::byte*>(container) + offset, &value, sizeof(value));
+}
+std::uintptr_t read_word(const void* container, std::uint8_t offset) {
+  std::uintptr_t value;
+  std::memcpy(&value, static_cast<const std::byte*>(container) + offset, sizeof(value));
+  return value;
+}
+
+// A cloud whose containers lie, one way per message: where a subscriber must
+// refuse to read, naming the field. The messages are never destroyed (the
+// process ends with _Exit), since their destructors would free what the words
+// now point to.
+int hostile_clouds(const std::string& topic) {
+  const agnocast::ContainerLayout& layout = agnocast::native_container_layout();
+  constexpr std::uintptr_t unmapped = 0x10000;  // below any pool, mapped by no one
+  agnocast::Node node{"python_peer_hostile"};
+  auto pub = node.create_publisher<sensor_msgs::msg::PointCloud2>(topic, agnocast::QoS{10});
+  if (!pub->wait_for_subscribers(1, 60s)) return 1;
+  const char* faults[] = {"data_outside", "data_huge", "fields_misaligned", "frame_id_outside"};
+  for (const char* fault : faults) {
+    auto m = pub->borrow_loaned_message();
+    fill(*m, 1, 64);
+    const std::string name = fault;
+    if (name == "data_outside") {
+      write_word(&m->data, layout.vector_begin_offset, unmapped);
+      write_word(&m->data, layout.vector_end_offset, unmapped + 64);
+    } else if (name == "data_huge") {
+      const std::uintptr_t begin = read_word(&m->data, layout.vector_begin_offset);
+      write_word(&m->data, layout.vector_end_offset, begin + (std::uintptr_t{1} << 40));
+    } else if (name == "fields_misaligned") {
+      write_word(&m->fields, layout.vector_begin_offset,
+                 read_word(&m->fields, layout.vector_begin_offset) + 1);
+      write_word(&m->fields, layout.vector_end_offset,
+                 read_word(&m->fields, layout.vector_end_offset) + 1);
+    } else {
+      write_word(&m->header.frame_id, layout.string_data_offset, unmapped);
+    }
+    std::printf("%s\n", fault);
+    std::fflush(stdout);
+    pub->publish(std::move(m));
+    std::this_thread::sleep_for(100ms);
+  }
+  while (std::getchar() != EOF) {
+  }
+  std::_Exit(0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "hostile" && std::string(argv[2]) == "cloud") {
+    return hostile_clouds(argv[3]);
+  }
   if (argc < 5) {
-    std::fprintf(stderr, "usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]\n");
+    std::fprintf(stderr,
+                 "usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]\n"
+                 "       python_peer hostile cloud TOPIC\n");
     return 2;
   }
   const bool publish = std::string(argv[1]) == "pub";

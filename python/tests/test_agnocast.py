@@ -117,6 +117,47 @@ def test_cloud_from_cpp_is_a_read_only_view_of_the_publishers_pool():
         assert nbytes >= size
 
 
+def test_a_hostile_publishers_containers_raise_and_are_never_read():
+    # python_peer hostile rewrites one vector or string word per message, after
+    # filling its loan: data outside its pool, data 2^40 bytes long, fields
+    # misaligned, frame_id outside its pool.
+    node = agnocast.Node("py_hostile_sub")
+    received = []
+    sub = node.create_subscription(PointCloud2, "/py/hostile", 10,
+                                   lambda msg, info: received.append(msg))
+    cpp = peer("hostile", "cloud", "/py/hostile")
+    spin_until(node, lambda: len(received) == 4)
+    faults = dict(zip(["data_outside", "data_huge", "fields_misaligned", "frame_id_outside"],
+                      received))
+
+    for fault in ["data_outside", "data_huge"]:
+        msg = faults[fault]
+        for read in [np.asarray, len, memoryview, lambda data: data[0], repr]:
+            with pytest.raises(agnocast.InvalidMessage, match="field 'data'"):
+                read(msg.data)
+        with pytest.raises(agnocast.Error, match="field 'data'"):
+            np.frombuffer(msg.data, dtype=np.uint8)
+        # What does not lie stays readable.
+        assert msg.header.frame_id == "lidar" and len(msg.fields) == 1
+    msg = faults["fields_misaligned"]
+    with pytest.raises(agnocast.InvalidMessage, match="field 'fields'.*misaligned"):
+        len(msg.fields)
+    assert np.asarray(msg.data).shape == (64,)
+    msg = faults["frame_id_outside"]
+    with pytest.raises(agnocast.InvalidMessage, match="field 'frame_id'.*outside"):
+        msg.header.frame_id
+    # Copying a lying message into a loan checks the same words.
+    loan = PointCloud2()
+    with pytest.raises(agnocast.InvalidMessage, match="field 'data'"):
+        loan.data = faults["data_outside"].data
+    with pytest.raises(agnocast.InvalidMessage, match="field 'frame_id'"):
+        loan.header = faults["frame_id_outside"].header
+    node.destroy_subscription(sub)
+    received.clear()
+    faults.clear()
+    assert finish(cpp) == ["data_outside", "data_huge", "fields_misaligned", "frame_id_outside"]
+
+
 def test_cloud_from_python_is_written_in_place():
     size = 1 << 16
     cpp = peer("sub", "cloud", "/py/cloud_out", 1)

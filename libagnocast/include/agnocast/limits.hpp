@@ -33,6 +33,10 @@ inline constexpr std::size_t type_name_max = 127;
 
 // The schema the kernel stores per topic, in bytes (AGNOCAST_SCHEMA_MAX).
 inline constexpr std::size_t schema_max_bytes = 4096;
+// How deep messages may nest in a schema (the message itself is level 1):
+// readers of foreign messages recurse once per level. ROS 2's standard types
+// nest at most 5 deep.
+inline constexpr std::size_t message_max_nesting = 32;
 
 // Endpoints of one topic (AGNOCAST_PUBLISHERS_PER_TOPIC_MAX,
 // AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX).

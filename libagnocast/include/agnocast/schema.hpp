@@ -29,6 +29,7 @@
 
 #include "agnocast/limits.hpp"
 #include "agnocast/message_traits.hpp"
+#include "agnocast/schema_layout.hpp"
 
 namespace agnocast {
 
@@ -41,16 +42,6 @@ inline constexpr std::uint16_t schema_no_type = 0xFFFF;
 class SchemaError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
-};
-
-struct ContainerLayout {
-  std::uint8_t pointer_size = 0;
-  std::uint8_t vector_size = 0;
-  std::uint8_t vector_begin_offset = 0;
-  std::uint8_t vector_end_offset = 0;
-  std::uint8_t string_size = 0;
-  std::uint8_t string_data_offset = 0;
-  std::uint8_t string_length_offset = 0;
 };
 
 struct SchemaField {
@@ -80,9 +71,6 @@ struct Schema {
   ContainerLayout containers;
   std::vector<SchemaType> types;
 };
-
-// The container layout of the standard library this library was built with.
-const ContainerLayout& native_container_layout();
 
 // The blob for a type and everything nested in it. Throws SchemaError when it
 // would exceed schema_max_bytes.

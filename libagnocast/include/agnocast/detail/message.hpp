@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 
 namespace agnocast::detail {
 
@@ -54,6 +55,10 @@ struct Publication {
 };
 Publication read_publication(const void* message, const void* pool_begin,
                              std::size_t pool_size) noexcept;
+// The pool mapped in this process that holds `address` (a publisher's, read-only,
+// or this process's own), or an empty span: what a reader of a received
+// message may read (ForeignMemory, <agnocast/schema_walk.hpp>).
+std::span<const std::byte> pool_holding(const void* address);
 // Frees memory from allocate_message whose object was never constructed.
 void free_message_memory(void* message) noexcept;
 // Destroys a constructed, unpublished message and frees its memory.

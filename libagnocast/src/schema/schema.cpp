@@ -13,52 +13,6 @@ constexpr std::size_t header_bytes = 20;
 constexpr std::size_t type_fixed_bytes = 8 + 4 + 4 + 2 + 1;
 constexpr std::size_t field_fixed_bytes = 1 + 1 + 1 + 2 + 7 * 4;
 
-// Same layout as agnocast::allocator (stateless), but on the heap: for probing.
-template <class T>
-struct HeapAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = HeapAllocator<U>;
-  };
-  HeapAllocator() = default;
-  template <class U>
-  HeapAllocator(const HeapAllocator<U>&) noexcept {}
-};
-using ProbeVector = std::vector<std::uint64_t, HeapAllocator<std::uint64_t>>;
-using ProbeString = std::basic_string<char, std::char_traits<char>, HeapAllocator<char>>;
-static_assert(sizeof(ProbeVector) == sizeof(agnocast::vector<std::uint64_t>));
-static_assert(sizeof(ProbeString) == sizeof(agnocast::string));
-
-// Where in `object` a word equal to `value` is.
-template <class Object>
-std::uint8_t offset_of_word(const Object& object, std::uintptr_t value) {
-  for (std::size_t offset = 0; offset + sizeof(value) <= sizeof(Object); offset += sizeof(value)) {
-    std::uintptr_t word;
-    std::memcpy(&word, reinterpret_cast<const char*>(&object) + offset, sizeof(word));
-    if (word == value) return static_cast<std::uint8_t>(offset);
-  }
-  throw std::logic_error("agnocast: unknown container layout in this standard library");
-}
-
-// Not inlined: GCC 12 at -O3 misreads the string's heap buffer as the constant 40
-// (-Wfree-nonheap-object) once this is inlined into its caller.
-[[gnu::noinline]] ContainerLayout probe_container_layout() {
-  ProbeVector vector(3);
-  ProbeString string(40, 'x');  // longer than any small-string buffer
-  ContainerLayout layout;
-  layout.pointer_size = sizeof(void*);
-  layout.vector_size = sizeof(ProbeVector);
-  layout.vector_begin_offset =
-      offset_of_word(vector, reinterpret_cast<std::uintptr_t>(vector.data()));
-  layout.vector_end_offset =
-      offset_of_word(vector, reinterpret_cast<std::uintptr_t>(vector.data() + vector.size()));
-  layout.string_size = sizeof(ProbeString);
-  layout.string_data_offset =
-      offset_of_word(string, reinterpret_cast<std::uintptr_t>(string.data()));
-  layout.string_length_offset = offset_of_word(string, string.size());
-  return layout;
-}
-
 class BlobWriter {
  public:
   void u8(std::uint8_t value) { bytes_.push_back(value); }
@@ -199,12 +153,23 @@ void check_field(const Schema& schema, std::size_t type_index, const SchemaField
   }
 }
 
-}  // namespace
-
-const ContainerLayout& native_container_layout() {
-  static const ContainerLayout layout = probe_container_layout();
-  return layout;
+// A nested type's index is greater than its user's (check_field), so each
+// type's depth follows from those after it, last first.
+void check_nesting(const Schema& schema) {
+  std::vector<std::size_t> depth(schema.types.size(), 1);
+  for (std::size_t i = schema.types.size(); i-- > 0;) {
+    for (const SchemaField& field : schema.types[i].fields) {
+      if (field.kind == FieldKind::Message) depth[i] = std::max(depth[i], depth[field.nested] + 1);
+    }
+    if (depth[i] > message_max_nesting) {
+      throw SchemaError("schema: " + schema.types[i].name + " nests messages " +
+                        std::to_string(depth[i]) + " deep, more than the " +
+                        std::to_string(message_max_nesting) + " a reader follows");
+    }
+  }
 }
+
+}  // namespace
 
 std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
   // Reversed post-order: the message type first, every type before the types it uses.
@@ -252,6 +217,8 @@ std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
   }
   const auto total = static_cast<std::uint32_t>(blob.size());
   for (int i = 0; i < 4; ++i) blob[8 + i] = static_cast<std::uint8_t>(total >> (8 * i));
+  // What readers will refuse (nesting too deep) is refused here, at the writer.
+  parse_schema(blob);
   return std::move(blob);
 }
 
@@ -316,6 +283,7 @@ Schema parse_schema(std::span<const std::uint8_t> blob) {
   for (std::size_t i = 0; i < schema.types.size(); ++i) {
     for (const SchemaField& field : schema.types[i].fields) check_field(schema, i, field);
   }
+  check_nesting(schema);
   return schema;
 }
 

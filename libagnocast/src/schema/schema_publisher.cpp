@@ -14,7 +14,8 @@ namespace {
 void leave_to_block(void*) {}  // the block holds everything: freeing it is all
 
 // Reads XCDR1 (after the encapsulation header) into a message laid out as
-// the schema says, containers as libstdc++ lays them out. A first pass
+// the schema says, containers as this process's standard library lays them
+// out (the schema's own layout, checked by the constructor). A first pass
 // (memory == nullptr) only measures what the block needs after the message.
 class CdrToPool {
  public:
@@ -88,11 +89,10 @@ class CdrToPool {
           const std::size_t bytes = static_cast<std::size_t>(n) * field.element_size;
           std::byte* first = reserve(bytes, field.element_align);
           if (!dry_) std::memset(first, 0, bytes);
-          const ContainerLayout& layout = schema_.containers;
-          store_pointer(value + layout.vector_begin_offset, first);
-          store_pointer(value + layout.vector_end_offset, first + bytes);
-          // libstdc++'s third pointer, the end of storage.
-          store_pointer(value + 2 * layout.pointer_size, first + bytes);
+          const NativeContainerWords& words = native_container_words();
+          store_pointer(value + words.layout.vector_begin_offset, first);
+          store_pointer(value + words.layout.vector_end_offset, first + bytes);
+          store_pointer(value + words.vector_capacity_offset, first + bytes);
           elements(field, first, n);
           break;
         }
@@ -148,18 +148,18 @@ class CdrToPool {
     if (field.string_bound != 0 && size > field.string_bound) {
       fail("string '" + field.name + "' longer than its bound");
     }
-    const ContainerLayout& layout = schema_.containers;
-    // libstdc++: pointer, length, then 16 bytes of local buffer or the capacity.
-    constexpr std::size_t local_offset = 16;
-    constexpr std::size_t local_capacity = 15;
+    // A short string lives in its own local buffer, where the library expects
+    // it; a longer one in the block, its capacity equal to its length.
+    const NativeContainerWords& words = native_container_words();
+    const bool local = words.string_local_capacity > 0 && size <= words.string_local_capacity;
     std::byte* data =
-        size <= local_capacity ? (at ? at + local_offset : nullptr) : reserve(size + 1, 1);
+        local ? (at ? at + words.string_local_offset : nullptr) : reserve(size + 1, 1);
     if (dry_) return;
     std::memcpy(data, chars, size);
     data[size] = std::byte{0};
-    store_pointer(at + layout.string_data_offset, data);
-    std::memcpy(at + layout.string_length_offset, &size, sizeof size);
-    if (size > local_capacity) std::memcpy(at + local_offset, &size, sizeof size);
+    store_pointer(at + words.layout.string_data_offset, data);
+    std::memcpy(at + words.layout.string_length_offset, &size, sizeof size);
+    if (!local) std::memcpy(at + words.string_capacity_offset, &size, sizeof size);
   }
 
   const Schema& schema_;
@@ -170,24 +170,13 @@ class CdrToPool {
   bool dry_ = true;
 };
 
-// The layout CdrToPool writes: libstdc++'s, on a 64-bit machine.
-bool supported_layout(const ContainerLayout& layout) {
-  return layout.pointer_size == 8 && layout.vector_size == 24 && layout.vector_begin_offset == 0 &&
-         layout.vector_end_offset == 8 && layout.string_size == 32 &&
-         layout.string_data_offset == 0 && layout.string_length_offset == 8;
-}
-
 }  // namespace
 
 SchemaPublisher::SchemaPublisher(Node& node, std::string_view topic, const QoS& qos,
                                  std::string type_name, std::uint64_t type_hash,
                                  std::vector<std::uint8_t> blob)
     : type_name_(std::move(type_name)), blob_(std::move(blob)), schema_(parse_schema(blob_)) {
-  if (!supported_layout(schema_.containers)) {
-    throw SchemaError("the type " + type_name_ +
-                      " lays out its containers otherwise than libstdc++ on a 64-bit machine, "
-                      "the only layout written from CDR");
-  }
+  require_native_layout(schema_.containers, type_name_, "a message written from CDR");
   core_ = std::make_unique<detail::PublisherCore>(
       node.state(), topic, qos, detail::MessageType{type_name_, type_hash, blob_});
 }

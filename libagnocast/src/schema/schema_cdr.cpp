@@ -3,155 +3,93 @@
 #include <algorithm>
 #include <cstring>
 
+#include "agnocast/schema_walk.hpp"
+
 namespace agnocast {
 namespace {
 
-template <class T>
-T load(const std::byte* at) {
-  T value;
-  std::memcpy(&value, at, sizeof(T));
-  return value;
-}
-
+// Writes the CDR form of a message as SchemaWalk visits it.
 class SchemaCdrWriter {
  public:
-  SchemaCdrWriter(const Schema& schema, const SchemaCdrOptions& options,
-                  std::vector<std::uint8_t>& out)
-      : schema_(schema), options_(options), out_(out), writer_(out) {}
+  SchemaCdrWriter(const SchemaCdrOptions& options, std::vector<std::uint8_t>& out)
+      : options_(options), out_(out), writer_(out) {}
 
-  void message(const SchemaType& type, const std::byte* at) {
-    for (const SchemaField& field : type.fields) {
-      const std::byte* value = at + field.offset;
-      switch (field.shape) {
-        case FieldShape::Single:
-          elements(field, value, 1);
-          break;
-        case FieldShape::Array:
-          elements(field, value, field.array_length);
-          break;
-        case FieldShape::Sequence:
-          sequence(field, value);
-          break;
-      }
-      if (out_.size() > options_.max_bytes) fail(field, "more bytes than a message may produce");
+  void begin_message(const SchemaType&) {}
+  void end_message(const SchemaType&) {}
+  void begin_field(const SchemaField&) {}
+  void end_field(const SchemaField& field) { check_size(field); }
+
+  void scalar(const SchemaField& field, const std::byte* at) { numbers(field, at, 1); }
+  void numbers(const SchemaField& field, const std::byte* first, std::size_t count) {
+    switch (field.kind) {
+      case FieldKind::Bool:  // one byte, as in memory
+      case FieldKind::UInt8:
+        return primitives<std::uint8_t>(first, count);
+      case FieldKind::Int8:
+        return primitives<std::int8_t>(first, count);
+      case FieldKind::Int16:
+        return primitives<std::int16_t>(first, count);
+      case FieldKind::UInt16:
+        return primitives<std::uint16_t>(first, count);
+      case FieldKind::Int32:
+        return primitives<std::int32_t>(first, count);
+      case FieldKind::UInt32:
+        return primitives<std::uint32_t>(first, count);
+      case FieldKind::Int64:
+        return primitives<std::int64_t>(first, count);
+      case FieldKind::UInt64:
+        return primitives<std::uint64_t>(first, count);
+      case FieldKind::Float32:
+        return primitives<float>(first, count);
+      case FieldKind::Float64:
+        return primitives<double>(first, count);
+      default:
+        fail(field, "not a number");
     }
   }
-
-  void check_root(const void* message, const SchemaType& root) const {
-    if (root.fields.empty()) {
-      throw cdr::Error("type " + root.name + " describes no fields, so it has no CDR form");
-    }
-    const auto at = reinterpret_cast<std::uintptr_t>(message);
-    if (!readable(at, root.size)) {
-      throw cdr::Error("message of type " + root.name + " lies outside the publisher's pool");
-    }
+  void opaque(const SchemaField& field, const std::byte*, std::size_t) {
+    fail(field, "opaque bytes without a field description have no CDR form");
   }
+  void text(const SchemaField& field, const ForeignText& found) {
+    if (found.problem) fail(field, found.problem);
+    if (found.text.size() >= 0xFFFFFFFFu) fail(field, "string longer than CDR can count");
+    writer_.write(static_cast<std::uint32_t>(found.text.size() + 1));
+    if (!found.text.empty()) writer_.write_elements(found.text.data(), found.text.size());
+    writer_.write('\0');
+  }
+
+  bool begin_elements(const SchemaField& field, const ForeignElements& found) {
+    if (found.problem) fail(field, found.problem);
+    if (field.shape == FieldShape::Sequence) {
+      if (found.count > 0xFFFFFFFFu) fail(field, "sequence longer than CDR can count");
+      writer_.write(static_cast<std::uint32_t>(found.count));
+    }
+    return true;
+  }
+  void begin_element(const SchemaField& field, std::size_t) {
+    if (field.kind == FieldKind::Message) check_size(field);
+  }
+  void end_elements(const SchemaField&) {}
 
  private:
   [[noreturn]] static void fail(const SchemaField& field, const std::string& problem) {
     throw cdr::Error("field '" + field.name + "': " + problem);
   }
-
-  bool readable(std::uintptr_t at, std::size_t bytes) const {
-    if (!options_.readable) return true;
-    const auto begin = reinterpret_cast<std::uintptr_t>(options_.readable->data());
-    const std::uintptr_t end = begin + options_.readable->size();
-    return at >= begin && at <= end && bytes <= end - at;
-  }
-
-  static bool aligned(std::uintptr_t at, std::uint32_t align) {
-    const bool power_of_two = align != 0 && (align & (align - 1)) == 0;
-    return !power_of_two || at % align == 0;
-  }
-
-  void sequence(const SchemaField& field, const std::byte* at) {
-    const ContainerLayout& layout = schema_.containers;
-    const auto begin = load<std::uintptr_t>(at + layout.vector_begin_offset);
-    const auto end = load<std::uintptr_t>(at + layout.vector_end_offset);
-    if (end < begin) fail(field, "sequence ends before its begin");
-    const std::size_t bytes = end - begin;
-    if (field.element_size == 0 || bytes % field.element_size != 0) {
-      fail(field, "sequence length is no whole number of elements");
-    }
-    const std::size_t count = bytes / field.element_size;
-    if (field.sequence_bound != 0 && count > field.sequence_bound) {
-      fail(field, "sequence longer than its bound");
-    }
-    if (count > 0xFFFFFFFFu) fail(field, "sequence longer than CDR can count");
-    writer_.write(static_cast<std::uint32_t>(count));
-    if (count == 0) return;
-    if (options_.readable) {
-      if (!aligned(begin, field.element_align)) fail(field, "misaligned sequence");
-      if (!readable(begin, bytes)) fail(field, "sequence outside the publisher's pool");
-    }
-    elements(field, reinterpret_cast<const std::byte*>(begin), count);
+  // Containers that alias one another could multiply the output without bound.
+  void check_size(const SchemaField& field) const {
+    if (out_.size() > options_.max_bytes) fail(field, "more bytes than a message may produce");
   }
 
   template <class T>
   void primitives(const std::byte* at, std::size_t count) {
     if (count == 1) {
-      writer_.write(load<T>(at));
-    } else {
-      // In place in the pool, aligned as T (checked above or by the schema's layout).
+      writer_.write(load_unaligned<T>(at));
+    } else if (count > 0) {
+      // In place in the pool, aligned as T (checked by field_elements or the schema's layout).
       writer_.write_elements(reinterpret_cast<const T*>(at), count);
     }
   }
 
-  void elements(const SchemaField& field, const std::byte* at, std::size_t count) {
-    switch (field.kind) {
-      case FieldKind::Bool:  // one byte, as in memory
-      case FieldKind::UInt8:
-        return primitives<std::uint8_t>(at, count);
-      case FieldKind::Int8:
-        return primitives<std::int8_t>(at, count);
-      case FieldKind::Int16:
-        return primitives<std::int16_t>(at, count);
-      case FieldKind::UInt16:
-        return primitives<std::uint16_t>(at, count);
-      case FieldKind::Int32:
-        return primitives<std::int32_t>(at, count);
-      case FieldKind::UInt32:
-        return primitives<std::uint32_t>(at, count);
-      case FieldKind::Int64:
-        return primitives<std::int64_t>(at, count);
-      case FieldKind::UInt64:
-        return primitives<std::uint64_t>(at, count);
-      case FieldKind::Float32:
-        return primitives<float>(at, count);
-      case FieldKind::Float64:
-        return primitives<double>(at, count);
-      case FieldKind::String:
-        for (std::size_t i = 0; i < count; ++i) string(field, at + i * field.element_size);
-        return;
-      case FieldKind::Message:
-        for (std::size_t i = 0; i < count; ++i) {
-          message(schema_.types[field.nested], at + i * field.element_size);
-          if (out_.size() > options_.max_bytes) {
-            fail(field, "more bytes than a message may produce");
-          }
-        }
-        return;
-      case FieldKind::Opaque:
-        break;
-    }
-    fail(field, "opaque bytes without a field description have no CDR form");
-  }
-
-  void string(const SchemaField& field, const std::byte* at) {
-    const ContainerLayout& layout = schema_.containers;
-    const auto data = load<std::uintptr_t>(at + layout.string_data_offset);
-    const auto length = load<std::size_t>(at + layout.string_length_offset);
-    if (field.string_bound != 0 && length > field.string_bound) {
-      fail(field, "string longer than its bound");
-    }
-    if (length >= 0xFFFFFFFFu) fail(field, "string longer than CDR can count");
-    if (length > 0 && !readable(data, length)) fail(field, "string outside the publisher's pool");
-    writer_.write(static_cast<std::uint32_t>(length + 1));
-    if (length > 0) writer_.write_elements(reinterpret_cast<const char*>(data), length);
-    writer_.write('\0');
-  }
-
-  const Schema& schema_;
   const SchemaCdrOptions& options_;
   std::vector<std::uint8_t>& out_;
   cdr::Writer writer_;
@@ -240,9 +178,18 @@ void collect_dependencies(const Schema& schema, const SchemaType& type, std::vec
 void serialize_with_schema(const void* message, const Schema& schema,
                            std::vector<std::uint8_t>& out, const SchemaCdrOptions& options) {
   out.assign(cdr::encapsulation_header.begin(), cdr::encapsulation_header.end());
-  SchemaCdrWriter writer(schema, options, out);
-  writer.check_root(message, schema.types.at(0));
-  writer.message(schema.types[0], static_cast<const std::byte*>(message));
+  const SchemaType& root = schema.types.at(0);
+  if (root.fields.empty()) {
+    throw cdr::Error("type " + root.name + " describes no fields, so it has no CDR form");
+  }
+  const ForeignMemory memory =
+      options.readable ? ForeignMemory(*options.readable) : ForeignMemory();
+  if (const char* problem = message_problem(root, message, memory)) {
+    throw cdr::Error(root.name + ": " + problem);
+  }
+  SchemaCdrWriter writer(options, out);
+  SchemaWalk<SchemaCdrWriter>(schema, memory, writer)
+      .message(root, static_cast<const std::byte*>(message));
 }
 
 std::string ros2msg_type_name(std::string_view type_name) {

@@ -843,6 +843,8 @@ PYBIND11_MODULE(_core, m) {
       message_published(e.what());
     } catch (const ReadOnlyMessage& e) {
       read_only(e.what());
+    } catch (const InvalidMessage& e) {
+      invalid_message(e.what());
     } catch (const Error& e) {
       error(e.what());
     } catch (const SchemaError& e) {

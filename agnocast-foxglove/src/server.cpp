@@ -23,6 +23,7 @@
 #include "agnocast/schema_cdr.hpp"
 #include "agnocast/schema_publisher.hpp"
 #include "agnocast/schema_subscription.hpp"
+#include "agnocast/schema_topic.hpp"
 #include "agnocast/signals.hpp"
 #include "agnocast_service/notify.hpp"
 #include "agnocast_service/watchdog.hpp"
@@ -412,20 +413,19 @@ class Server final : public WebSocketHandler {
         if (item.encoding != "cdr") {
           throw ProtocolError("encoding '" + item.encoding + "' is not supported (only cdr)");
         }
-        const std::optional<TopicInfo> info = topic_info(item.topic);
-        const std::optional<std::vector<std::uint8_t>> blob =
-            info ? topic_schema(item.topic) : std::nullopt;
-        if (!info || !blob) {
+        std::optional<SchemaTopic> live = find_schema_topic(item.topic);
+        if (!live) {
           throw ProtocolError("topic " + item.topic +
                               " has no typed endpoint, so its layout is unknown: start a "
                               "subscriber of it first");
         }
-        if (ros2msg_type_name(item.schema_name) != ros2msg_type_name(info->type_name)) {
-          throw ProtocolError("topic " + item.topic + " has type " + info->type_name + ", not " +
+        if (ros2msg_type_name(item.schema_name) != ros2msg_type_name(live->type_name)) {
+          throw ProtocolError("topic " + item.topic + " has type " + live->type_name + ", not " +
                               item.schema_name);
         }
         client.publishers[item.id] = std::make_unique<SchemaPublisher>(
-            node_, item.topic, QoS(publisher_depth), info->type_name, info->type_hash, *blob);
+            node_, item.topic, QoS(publisher_depth), live->type_name, live->type_hash,
+            std::move(live->blob));
         ++ours_[item.topic];
       } catch (const std::exception& error) {
         status(id, client, StatusLevel::Error,

@@ -21,28 +21,6 @@ void write_pointer(void* vector, std::size_t offset, std::byte* value) {
 
 }  // namespace
 
-std::size_t primitive_size(FieldKind kind) {
-  switch (kind) {
-    case FieldKind::Bool:
-    case FieldKind::Int8:
-    case FieldKind::UInt8:
-      return 1;
-    case FieldKind::Int16:
-    case FieldKind::UInt16:
-      return 2;
-    case FieldKind::Int32:
-    case FieldKind::UInt32:
-    case FieldKind::Float32:
-      return 4;
-    case FieldKind::Int64:
-    case FieldKind::UInt64:
-    case FieldKind::Float64:
-      return 8;
-    default:
-      return 0;
-  }
-}
-
 bool is_primitive(FieldKind kind) { return primitive_size(kind) != 0; }
 
 ErasedSchema::ErasedSchema(std::vector<std::uint8_t> blob)

@@ -91,8 +91,7 @@ class ErasedOps {
   const ErasedSchema& schema_;
 };
 
-// Bytes of one element of kind (0 for String, Message and Opaque).
-std::size_t primitive_size(FieldKind kind);
+// Whether a kind is a number or bool (agnocast::primitive_size() gives its bytes).
 bool is_primitive(FieldKind kind);
 
 }  // namespace agnocast::python

@@ -17,6 +17,7 @@
 #include "agnocast/mcap/reader.hpp"
 #include "agnocast/node.hpp"
 #include "agnocast/schema_publisher.hpp"
+#include "agnocast/schema_topic.hpp"
 #include "agnocast/signals.hpp"
 #include "bag/bag.hpp"
 #include "standard_types.hpp"
@@ -67,13 +68,19 @@ int bag_play(const BagPlayOptions& options, std::ostream& out) {
     const std::string type_name = schema->second.name;
     std::uint64_t type_hash = 0;
     std::vector<std::uint8_t> blob;
-    if (const auto info = topic_info(channel.topic)) {
-      if (info->type_name != type_name) {
-        throw InputError("topic '" + channel.topic + "' has type " + info->type_name +
+    std::optional<SchemaTopic> live;
+    try {
+      live = find_schema_topic(channel.topic);
+    } catch (const Error& error) {  // a typed topic without schema, or an invalid one
+      throw InputError(error.what());
+    }
+    if (live) {
+      if (live->type_name != type_name) {
+        throw InputError("topic '" + channel.topic + "' has type " + live->type_name +
                          ", the file's is " + type_name);
       }
-      type_hash = info->type_hash;
-      blob = topic_schema(channel.topic).value_or(std::vector<std::uint8_t>{});
+      type_hash = live->type_hash;
+      blob = std::move(live->blob);
     } else if (channel.metadata.contains("agnocast_schema")) {
       type_hash = std::stoull(channel.metadata.at("agnocast_type_hash"), nullptr, 16);
       blob = from_hex(channel.metadata.at("agnocast_schema"));

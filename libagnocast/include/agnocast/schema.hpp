@@ -72,6 +72,9 @@ struct Schema {
   std::vector<SchemaType> types;
 };
 
+// Bytes of one number or bool of this kind; 0 for strings, messages and opaque bytes.
+std::uint32_t primitive_size(FieldKind kind);
+
 // The blob for a type and everything nested in it. Throws SchemaError when it
 // would exceed schema_max_bytes.
 std::vector<std::uint8_t> build_schema(const TypeDescriptor& type);

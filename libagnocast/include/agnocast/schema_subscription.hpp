@@ -33,11 +33,11 @@ class SchemaSubscription {
   SchemaSubscription(const SchemaSubscription&) = delete;
   SchemaSubscription& operator=(const SchemaSubscription&) = delete;
 
-  const Schema& schema() const { return schema_; }
+  const Schema& schema() const { return topic_.schema; }
   // The schema as the kernel holds it.
-  const std::vector<std::uint8_t>& schema_blob() const { return blob_; }
-  const std::string& type_name() const { return type_name_; }
-  std::uint64_t type_hash() const { return type_hash_; }
+  const std::vector<std::uint8_t>& schema_blob() const { return topic_.blob; }
+  const std::string& type_name() const { return topic_.type_name; }
+  std::uint64_t type_hash() const { return topic_.type_hash; }
   const std::string& topic() const;
   // The subscriber's id on the topic (agnocast-cli topic info lists its drops by it).
   std::uint32_t id() const;
@@ -49,10 +49,7 @@ class SchemaSubscription {
 
  private:
   class Core;
-  std::string type_name_;
-  std::uint64_t type_hash_ = 0;
-  std::vector<std::uint8_t> blob_;
-  Schema schema_;
+  SchemaTopic topic_;
   std::shared_ptr<Core> core_;
 };
 

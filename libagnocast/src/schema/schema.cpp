@@ -87,27 +87,8 @@ void fail(const SchemaType& type, const SchemaField& field, const char* what) {
 }
 
 std::uint32_t element_size_of(FieldKind kind, const ContainerLayout& containers) {
-  switch (kind) {
-    case FieldKind::Bool:
-    case FieldKind::Int8:
-    case FieldKind::UInt8:
-      return 1;
-    case FieldKind::Int16:
-    case FieldKind::UInt16:
-      return 2;
-    case FieldKind::Int32:
-    case FieldKind::UInt32:
-    case FieldKind::Float32:
-      return 4;
-    case FieldKind::Int64:
-    case FieldKind::UInt64:
-    case FieldKind::Float64:
-      return 8;
-    case FieldKind::String:
-      return containers.string_size;
-    default:
-      return 0;  // Message and Opaque: checked against their own size
-  }
+  if (kind == FieldKind::String) return containers.string_size;
+  return primitive_size(kind);  // 0 for Message and Opaque: checked against their own size
 }
 
 void check_field(const Schema& schema, std::size_t type_index, const SchemaField& field) {
@@ -170,6 +151,28 @@ void check_nesting(const Schema& schema) {
 }
 
 }  // namespace
+
+std::uint32_t primitive_size(FieldKind kind) {
+  switch (kind) {
+    case FieldKind::Bool:
+    case FieldKind::Int8:
+    case FieldKind::UInt8:
+      return 1;
+    case FieldKind::Int16:
+    case FieldKind::UInt16:
+      return 2;
+    case FieldKind::Int32:
+    case FieldKind::UInt32:
+    case FieldKind::Float32:
+      return 4;
+    case FieldKind::Int64:
+    case FieldKind::UInt64:
+    case FieldKind::Float64:
+      return 8;
+    default:
+      return 0;
+  }
+}
 
 std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
   // Reversed post-order: the message type first, every type before the types it uses.

@@ -2,7 +2,6 @@
 
 #include <utility>
 
-#include "agnocast/inspect.hpp"
 #include "runtime.hpp"
 
 namespace agnocast {
@@ -26,27 +25,9 @@ class SchemaSubscription::Core : public detail::SubscriptionBase {
 };
 
 SchemaSubscription::SchemaSubscription(Node& node, std::string_view topic, const QoS& qos,
-                                       Callback callback) {
-  const std::string name(topic);
-  const std::optional<TopicInfo> info = topic_info(name);
-  if (!info) {
-    throw TopicWithoutSchema("no publisher or subscriber uses topic '" + name +
-                             "', so its message type is unknown");
-  }
-  std::optional<std::vector<std::uint8_t>> blob = topic_schema(name);
-  if (!blob || blob->empty()) {
-    throw TopicWithoutSchema("topic '" + name + "' (type " + info->type_name +
-                             ") has no schema: its endpoints were built with a type that does "
-                             "not describe its fields; declare it with AGNOCAST_MESSAGE or "
-                             "generate it with agnocast-msggen and rebuild the publisher");
-  }
-  type_name_ = info->type_name;
-  type_hash_ = info->type_hash;
-  blob_ = std::move(*blob);
-  schema_ = parse_schema(blob_);
-  core_ = std::make_shared<Core>(
-      node, topic, qos, detail::MessageType{type_name_, type_hash_, blob_}, std::move(callback));
-}
+                                       Callback callback)
+    : topic_(resolve_schema_topic(topic)),
+      core_(std::make_shared<Core>(node, topic, qos, topic_.message_type(), std::move(callback))) {}
 
 SchemaSubscription::~SchemaSubscription() = default;
 

@@ -25,9 +25,11 @@
 #include "agnocast/schema_subscription.hpp"
 #include "agnocast/schema_topic.hpp"
 #include "agnocast/signals.hpp"
+#include "agnocast/topic_watcher.hpp"
 #include "agnocast_service/notify.hpp"
 #include "agnocast_service/watchdog.hpp"
 #include "protocol.hpp"
+#include "standard_msg_texts.hpp"
 
 namespace agnocast::foxglove {
 namespace {
@@ -524,53 +526,30 @@ class Server final : public WebSocketHandler {
     }
   }
 
-  // Topics appear and disappear: a typed topic is a channel while an endpoint
-  // that is not this server's uses it.
-  void discover() {
-    std::set<std::string> present;
-    std::vector<Channel> added;
-    std::vector<std::uint32_t> removed;
-    for (const TopicSummary& topic : list_topics()) {
-      const std::uint32_t endpoints = topic.publishers + topic.subscribers;
-      const auto ours = ours_.find(topic.name);
-      if (endpoints <= (ours == ours_.end() ? 0 : ours->second)) continue;
-      if (topic.type_name.empty() || topic.type_name.starts_with("raw:")) continue;
-      if (options_.topics && !std::regex_match(topic.name, *options_.topics)) continue;
-      const auto known = channels_.find(topic.name);
-      if (known != channels_.end()) {
-        if (known->second.type_name == topic.type_name &&
-            known->second.type_hash == topic.type_hash) {
-          present.insert(topic.name);
-        }
-        continue;  // another type: removed below, added at the next look
-      }
-      const std::string key = topic.name + "\n" + std::to_string(topic.type_hash);
-      if (unusable_.contains(key)) continue;
-      std::string definition;
-      try {
-        const std::optional<std::vector<std::uint8_t>> blob = topic_schema(topic.name);
-        if (!blob) continue;  // gone meanwhile
-        definition = ros2msg_definition(parse_schema(*blob));
-      } catch (const std::exception& error) {
-        unusable_.insert(key);
-        log("not serving " + topic.name + " (" + topic.type_name + "): " + error.what());
-        continue;
-      }
-      const std::string identity = topic.name + "\n" + topic.type_name + "\n" + definition;
-      auto id = channel_ids_.find(identity);
-      if (id == channel_ids_.end()) id = channel_ids_.emplace(identity, next_channel_id_++).first;
-      KnownChannel channel{
-          {id->second, topic.name, topic.type_name, definition}, topic.type_name, topic.type_hash};
-      channel_topics_[channel.channel.id] = topic.name;
-      added.push_back(channel.channel);
-      channels_.emplace(topic.name, std::move(channel));
-      present.insert(topic.name);
+  // Which topics are channels: a typed topic while an endpoint that is not this
+  // server's uses it, with bag record's definitions.
+  TopicWatcherOptions watched_topics() {
+    TopicWatcherOptions watched;
+    watched.text_of = standard_msg_text;
+    if (options_.topics) {
+      watched.wanted = [this](const std::string& name) {
+        return std::regex_match(name, *options_.topics);
+      };
     }
-    for (auto known = channels_.begin(); known != channels_.end();) {
-      if (present.contains(known->first)) {
-        ++known;
-        continue;
-      }
+    watched.own_endpoints = [this](const std::string& name) {
+      const auto ours = ours_.find(name);
+      return ours == ours_.end() ? 0u : ours->second;
+    };
+    return watched;
+  }
+
+  // Topics appear, change type and disappear; clients hear of each change.
+  void discover() {
+    const TopicChanges changes = watcher_.poll();
+    std::vector<std::uint32_t> removed;
+    for (const std::string& name : changes.gone) {
+      const auto known = channels_.find(name);
+      if (known == channels_.end()) continue;
       const std::uint32_t id = known->second.channel.id;
       removed.push_back(id);
       channel_topics_.erase(id);
@@ -581,7 +560,23 @@ class Server final : public WebSocketHandler {
           return true;
         });
       }
-      known = channels_.erase(known);
+      channels_.erase(known);
+    }
+    std::vector<Channel> added;
+    for (const WatchedTopic& found : changes.appeared) {
+      const SchemaTopic& topic = found.topic;
+      const std::string identity = topic.topic + "\n" + topic.type_name + "\n" + found.definition;
+      auto id = channel_ids_.find(identity);
+      if (id == channel_ids_.end()) id = channel_ids_.emplace(identity, next_channel_id_++).first;
+      KnownChannel channel{{id->second, topic.topic, topic.type_name, found.definition},
+                           topic.type_name,
+                           topic.type_hash};
+      channel_topics_[channel.channel.id] = topic.topic;
+      added.push_back(channel.channel);
+      channels_.insert_or_assign(topic.topic, std::move(channel));
+    }
+    for (const RefusedTopic& topic : changes.refused) {
+      log("not serving " + topic.name + " (" + topic.type_name + "): " + topic.problem);
     }
     for (auto& [client_id, client] : clients_) {
       if (!removed.empty()) send(client_id, client, unadvertise_json(removed));
@@ -604,7 +599,7 @@ class Server final : public WebSocketHandler {
   std::map<std::string, std::uint32_t> channel_ids_;     // topic, type and schema -> id, kept
   std::uint32_t next_channel_id_ = 1;
   std::map<std::string, std::uint32_t> ours_;  // this server's endpoints per topic
-  std::set<std::string> unusable_;             // topic and type hash whose schema has no .msg form
+  TopicWatcher watcher_{watched_topics()};
 
   // The WebSocket thread's.
   std::map<ClientId, std::shared_ptr<Outbox>> outboxes_;

@@ -27,6 +27,7 @@
 #include "agnocast/schema_cdr.hpp"
 #include "agnocast/schema_subscription.hpp"
 #include "agnocast/signals.hpp"
+#include "agnocast/topic_watcher.hpp"
 #include "agnocast/version.hpp"
 #include "bag/bag.hpp"
 #include "standard_msg_texts.hpp"
@@ -87,6 +88,13 @@ std::string size_text(double bytes) {
   return buffer;
 }
 
+TopicWatcherOptions recorded_topics() {
+  TopicWatcherOptions options;
+  options.text_of = standard_msg_text;
+  options.publishers_only = true;
+  return options;
+}
+
 class Recorder {
  public:
   explicit Recorder(const BagRecordOptions& options)
@@ -104,16 +112,19 @@ class Recorder {
     if (!add(topic, problem)) throw InputError("cannot record topic '" + topic + "': " + problem);
   }
 
-  // --all: every typed topic not recorded yet; those that cannot be are named once.
+  // --all: every typed topic with a publisher not recorded yet; those that
+  // cannot be are named once.
   void discover() {
-    for (const TopicSummary& summary : list_topics()) {
-      if (recorded_.contains(summary.name) || refused_.contains(summary.name)) continue;
-      if (summary.publishers == 0) continue;  // nothing to record yet; looked at again later
+    const TopicChanges changes = watcher_.poll();
+    for (const WatchedTopic& found : changes.appeared) {
+      const std::string& name = found.topic.topic;
+      if (recorded_.contains(name) || refused_.contains(name)) continue;
       std::string problem;
-      if (!add(summary.name, problem)) {
-        refused_.insert(summary.name);
-        std::cerr << "agnocast-cli: not recording topic '" << summary.name << "': " << problem
-                  << '\n';
+      if (!add(name, problem)) refuse(name, problem);
+    }
+    for (const RefusedTopic& topic : changes.refused) {
+      if (!recorded_.contains(topic.name) && !refused_.contains(topic.name)) {
+        refuse(topic.name, topic.problem);
       }
     }
   }
@@ -153,6 +164,11 @@ class Recorder {
   }
 
  private:
+  void refuse(const std::string& name, const std::string& problem) {
+    refused_.insert(name);
+    std::cerr << "agnocast-cli: not recording topic '" << name << "': " << problem << '\n';
+  }
+
   bool add(const std::string& name, std::string& problem) {
     auto topic = std::make_unique<RecordedTopic>();
     topic->name = name;
@@ -352,6 +368,9 @@ class Recorder {
   Node node_;
   std::vector<std::unique_ptr<RecordedTopic>> topics_;
   std::set<std::string> recorded_;
+  // The same rules and definitions as agnocast-foxglove's; a recorder follows
+  // topics with a publisher, and keeps recording one that goes away.
+  TopicWatcher watcher_{recorded_topics()};
   std::set<std::string> refused_;
   std::map<std::string, std::uint16_t> schemas_;
   std::unique_ptr<mcap::Writer> writer_;

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "dds_domain.hpp"
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 extern "C" {
 #include "bridge_test_pattern.h"

@@ -14,7 +14,7 @@
 
 #include "agnocast/mcap/writer.hpp"
 #include "bag/bag.hpp"
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 #include "standard_msg_texts.hpp"
 
 namespace bag_sample {

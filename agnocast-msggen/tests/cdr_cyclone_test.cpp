@@ -13,7 +13,7 @@
 #include <sensor_msgs/msg/point_cloud2.hpp>
 
 #include "golden.h"
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace {
 

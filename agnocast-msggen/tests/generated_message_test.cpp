@@ -6,7 +6,7 @@
 #include <sensor_msgs/msg/point_cloud2.hpp>
 #include <type_traits>
 
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace same {
 // golden_msgs/Tire written by hand with the same layout...

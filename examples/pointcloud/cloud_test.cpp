@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace pointcloud {
 namespace {

@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "tlsf.hpp"
+#include "memory/tlsf.hpp"
 
 namespace agnocast::heaphook {
 namespace {

@@ -19,7 +19,7 @@
 
 #include "agnocast/heap_scope.hpp"
 #include "agnocast/node.hpp"
-#include "fake_runtime.hpp"
+#include "kernel/fake_runtime.hpp"
 #include "seed_message_agnocast.hpp"
 
 namespace agnocast::detail {

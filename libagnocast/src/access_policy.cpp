@@ -3,7 +3,7 @@
 #include <stdexcept>
 
 #include "agnocast/naming.hpp"
-#include "device.hpp"
+#include "kernel/device.hpp"
 
 namespace agnocast {
 

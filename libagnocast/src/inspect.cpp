@@ -6,7 +6,7 @@
 
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
-#include "device.hpp"
+#include "kernel/device.hpp"
 
 namespace agnocast {
 

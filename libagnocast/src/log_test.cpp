@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "agnocast/node.hpp"
-#include "fake_runtime.hpp"
+#include "kernel/fake_runtime.hpp"
 
 namespace agnocast::detail {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <unistd.h>
 
-#include "device.hpp"
+#include "kernel/device.hpp"
 
 namespace agnocast {
 

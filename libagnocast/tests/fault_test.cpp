@@ -698,7 +698,7 @@ TEST_F(Faults, SubscriberOutOfDescriptors) {
 // 3. The same with a queue of one slot (fs.mqueue.msg_max 1), which the
 // subscriber drains before it receives: the RECEIVE fails with EMFILE after
 // the module counted it as looking (no watchdog then), so the wake-up taken
-// must be queued again (handle_wakeup() in libagnocast/src/subscription.cpp),
+// must be queued again (handle_wakeup() in libagnocast/src/endpoints/subscription.cpp),
 // or the messages wait for the next PUBLISH.
 TEST_F(Faults, SubscriberOutOfDescriptorsWithOneSlotQueue) {
   const MsgMax msg_max(1);

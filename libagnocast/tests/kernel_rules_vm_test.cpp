@@ -1,5 +1,5 @@
 // The module follows the wake and release rules of kernel_rules.cpp, the
-// table FakeKernel is held to natively (src/kernel_rules_test.cpp). Each
+// table FakeKernel is held to natively (src/kernel/kernel_rules_test.cpp). Each
 // process of a scenario is a forked child that registers as the library does
 // (Runtime::get()) and performs the calls it is sent over a pipe on its own
 // Device; a death is a real SIGKILL, waited for until the module has torn the
@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "agnocast/inspect.hpp"
-#include "kernel_rules.hpp"
-#include "runtime.hpp"
+#include "kernel/kernel_rules.hpp"
+#include "kernel/runtime.hpp"
 
 namespace agnocast::detail::kernel_rules {
 namespace {

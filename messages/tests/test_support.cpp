@@ -5,7 +5,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace standard_messages_test {
 namespace {

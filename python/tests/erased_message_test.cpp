@@ -15,7 +15,7 @@
 #include <wheel_msgs/msg/wheel.hpp>
 
 #include "agnocast/allocator.hpp"
-#include "fake_runtime.hpp"
+#include "kernel/fake_runtime.hpp"
 
 namespace agnocast::python {
 namespace {

@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 #include "standard_msg_texts.hpp"
 #include "standard_types.hpp"
 

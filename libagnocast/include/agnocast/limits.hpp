@@ -1,6 +1,6 @@
 // The limits the library enforces on what a program asks of it, in one place.
 // Most mirror the kernel module's UAPI (<agnocast.h>); the library's device
-// layer (src/device.cpp, the one source that includes the UAPI header) checks
+// layer (src/kernel/device.cpp, the one source that includes the UAPI header) checks
 // at compile time that each still agrees with the kernel's constant. Programs
 // that validate a configuration before they create endpoints (agnocast-bridge
 // --check-config) take their bounds from here, so that what they accept the

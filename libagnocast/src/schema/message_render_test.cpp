@@ -9,8 +9,8 @@
 #include <span>
 #include <stdexcept>
 
-#include "fake_kernel.hpp"
-#include "runtime.hpp"
+#include "kernel/fake_kernel.hpp"
+#include "kernel/runtime.hpp"
 
 namespace render_test {
 

@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace agnocast {
 

@@ -1,4 +1,4 @@
-#include "fake_kernel.hpp"
+#include "kernel/fake_kernel.hpp"
 
 #include <sys/eventfd.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "notification_queue.hpp"
+#include "endpoints/notification_queue.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "kernel.hpp"
+#include "kernel/kernel.hpp"
 
 namespace agnocast::detail::kernel_rules {
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "agnocast/allocator.hpp"
-#include "fake_kernel.hpp"
-#include "runtime.hpp"
+#include "kernel/fake_kernel.hpp"
+#include "kernel/runtime.hpp"
 
 namespace agnocast::detail {
 namespace {

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "agnocast/inspect.hpp"
-#include "endpoint_request.hpp"
+#include "endpoints/endpoint_request.hpp"
 
 namespace agnocast::detail {
 

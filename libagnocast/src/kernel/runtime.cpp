@@ -1,4 +1,4 @@
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 #include <fcntl.h>
 #include <pthread.h>
@@ -17,8 +17,8 @@
 #include "agnocast/allocator.hpp"
 #include "agnocast/detail/message.hpp"
 #include "agnocast/errors.hpp"
-#include "device.hpp"
-#include "heap_hook.hpp"
+#include "kernel/device.hpp"
+#include "memory/heap_hook.hpp"
 
 namespace agnocast::detail {
 namespace {

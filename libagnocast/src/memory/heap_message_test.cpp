@@ -6,7 +6,7 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/heap_scope.hpp"
 #include "agnocast/node.hpp"
-#include "fake_runtime.hpp"
+#include "kernel/fake_runtime.hpp"
 #include "seed_message_agnocast.hpp"
 
 // seed::Msg written with agnocast containers: the same bytes in the pool.

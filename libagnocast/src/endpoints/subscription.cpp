@@ -16,11 +16,11 @@
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
-#include "endpoint_request.hpp"
+#include "endpoints/endpoint_request.hpp"
+#include "endpoints/node_state.hpp"
+#include "endpoints/notification_queue.hpp"
+#include "kernel/runtime.hpp"
 #include "log_internal.hpp"
-#include "node_state.hpp"
-#include "notification_queue.hpp"
-#include "runtime.hpp"
 
 namespace agnocast::detail {
 namespace {

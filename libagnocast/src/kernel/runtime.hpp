@@ -14,8 +14,8 @@
 #include <mutex>
 #include <span>
 
-#include "kernel.hpp"
-#include "tlsf.hpp"
+#include "kernel/kernel.hpp"
+#include "memory/tlsf.hpp"
 
 namespace agnocast::detail {
 

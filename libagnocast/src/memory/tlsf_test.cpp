@@ -1,4 +1,4 @@
-#include "tlsf.hpp"
+#include "memory/tlsf.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // FakeKernel follows the module's wake and release rules: the table of
 // kernel_rules.cpp, which tests/kernel_rules_vm_test.cpp runs against the
 // module in the VM.
-#include "kernel_rules.hpp"
+#include "kernel/kernel_rules.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/types.h>
@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "fake_kernel.hpp"
+#include "kernel/fake_kernel.hpp"
 
 namespace agnocast::detail::kernel_rules {
 namespace {

@@ -1,4 +1,4 @@
-#include "kernel_rules.hpp"
+#include "kernel/kernel_rules.hpp"
 
 #include <unistd.h>
 

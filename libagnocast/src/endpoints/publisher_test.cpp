@@ -11,7 +11,7 @@
 
 #include "agnocast/limits.hpp"
 #include "agnocast/node.hpp"
-#include "fake_runtime.hpp"
+#include "kernel/fake_runtime.hpp"
 
 namespace agnocast::detail {
 namespace {

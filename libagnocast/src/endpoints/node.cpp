@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "agnocast/limits.hpp"
-#include "node_state.hpp"
+#include "endpoints/node_state.hpp"
 
 namespace agnocast {
 namespace {

@@ -1,4 +1,4 @@
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/mman.h>
@@ -8,7 +8,7 @@
 #include <memory>
 #include <new>
 
-#include "fake_kernel.hpp"
+#include "kernel/fake_kernel.hpp"
 
 namespace agnocast::detail {
 namespace {

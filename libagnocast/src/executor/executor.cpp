@@ -21,9 +21,9 @@
 
 #include "agnocast/errors.hpp"
 #include "agnocast/signals.hpp"
-#include "node_state.hpp"
-#include "notification_queue.hpp"
-#include "runtime.hpp"
+#include "endpoints/node_state.hpp"
+#include "endpoints/notification_queue.hpp"
+#include "kernel/runtime.hpp"
 #include "signals_internal.hpp"
 
 namespace agnocast {
@@ -215,7 +215,7 @@ struct Executor::State {
   const int cancel_fd;
   const int change_fd;
   std::atomic<int> watched_wake_fd{-1};  // the runtime's, not ours to close
-  std::mutex mutex;  // nodes, armed, fds and watched_wake_fd
+  std::mutex mutex;                      // nodes, armed, fds and watched_wake_fd
   std::vector<std::shared_ptr<detail::NodeState>> nodes;
   std::map<std::uint64_t, std::weak_ptr<detail::Waitable>> armed;
   std::map<int, std::shared_ptr<FdWaitable>> fds;  // what add_fd() added, by descriptor

@@ -1,4 +1,4 @@
-#include "device.hpp"
+#include "kernel/device.hpp"
 
 #include <agnocast.h>
 #include <fcntl.h>

@@ -1,5 +1,5 @@
 // Loan scopes and the pool as the allocation hook sees them (heap_scope.hpp).
-#include "heap_hook.hpp"
+#include "memory/heap_hook.hpp"
 
 #include <dlfcn.h>
 
@@ -9,7 +9,7 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/heap_scope.hpp"
 #include "heaphook_interface.h"
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace agnocast::detail {
 namespace {

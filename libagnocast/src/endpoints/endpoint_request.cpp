@@ -1,4 +1,4 @@
-#include "endpoint_request.hpp"
+#include "endpoints/endpoint_request.hpp"
 
 #include <stdexcept>
 

@@ -1,7 +1,7 @@
 // The pool allocation behind agnocast::vector and agnocast::string (allocator.hpp).
 #include "agnocast/allocator.hpp"
 
-#include "runtime.hpp"
+#include "kernel/runtime.hpp"
 
 namespace agnocast::detail {
 namespace {

@@ -9,8 +9,8 @@
 
 #include "agnocast/allocator.hpp"
 #include "agnocast/heap_scope.hpp"
-#include "runtime.hpp"
-#include "tlsf.hpp"
+#include "kernel/runtime.hpp"
+#include "memory/tlsf.hpp"
 
 namespace agnocast::detail {
 namespace {

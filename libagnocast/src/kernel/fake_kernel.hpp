@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "kernel.hpp"
+#include "kernel/kernel.hpp"
 
 namespace agnocast::detail {
 

@@ -17,7 +17,7 @@
 #include "agnocast/inspect.hpp"
 #include "agnocast/supervise.hpp"
 #include "agnocast/version.hpp"
-#include "kernel.hpp"
+#include "kernel/kernel.hpp"
 
 namespace agnocast::detail {
 

@@ -11,8 +11,8 @@
 #include <new>
 #include <string>
 
-#include "fake_kernel.hpp"
-#include "runtime.hpp"
+#include "kernel/fake_kernel.hpp"
+#include "kernel/runtime.hpp"
 
 namespace agnocast::detail {
 

@@ -19,7 +19,7 @@
 
 #include "agnocast/executor.hpp"
 #include "agnocast/node.hpp"
-#include "fake_runtime.hpp"
+#include "kernel/fake_runtime.hpp"
 
 // The executor's waits and the timers armed, counted: libagnocast calls
 // these through the C library, which this program's definitions replace.

@@ -29,6 +29,7 @@
 #include "agnocast/inspect.hpp"
 #include "agnocast/mcap/reader.hpp"
 #include "agnocast/mcap/writer.hpp"
+#include "agnocast/schema_cdr.hpp"
 
 namespace bag_live {
 
@@ -404,6 +405,88 @@ TEST_F(BagLive, AForeignFileOfAStandardTypePlaysWithoutASubscriberFirst) {
   for (std::size_t i = 1; i < got.size(); ++i) {
     EXPECT_EQ(std::stoi(got[i].substr(8)), std::stoi(got[i - 1].substr(8)) + 1) << got[i];
   }
+}
+
+// A file another tool wrote of a type the CLI was not built with, and that
+// no running program has registered: bag play lays the type out from the
+// definition in the file (constants and comments included, as rosbag2 writes
+// it), so a subscriber compiled from the same fields that starts after the
+// player is accepted (same type hash) and receives every field exact.
+TEST_F(BagLive, AForeignFileOfAUserTypePlaysFromItsDefinitionWithoutASubscriberFirst) {
+  const std::string definition =
+      "# Text as another tool records it\n"
+      "uint8 KIND_PLAIN=0\n"
+      "string data\n"
+      "uint64 seq  # counts from 0\n"
+      "int32[] values\n"
+      "bool even\n";
+  const agnocast::Schema schema = agnocast::parse_schema(agnocast::schema_of<bag_live::Text>());
+  {
+    agnocast::mcap::Writer writer("foreign_user.mcap",
+                                  {.profile = "ros2",
+                                   .library = "another tool",
+                                   .compression = agnocast::mcap::Compression::Lz4});
+    const auto schema_id =
+        writer.add_schema("bag_live/msg/Text", "ros2msg", {definition.begin(), definition.end()});
+    const auto channel = writer.add_channel(schema_id, "/foreign_user", "cdr", {});
+    const std::uint64_t t0 = 1'700'000'000'000'000'000;
+    for (std::uint64_t i = 0; i < 60; ++i) {
+      bag_live::Text text;
+      text.data = ("text " + std::to_string(i)).c_str();
+      text.seq = i;
+      for (std::int32_t v = 0; v < static_cast<std::int32_t>(i % 5); ++v) {
+        text.values.push_back(v * 1000 - static_cast<std::int32_t>(i));
+      }
+      text.even = i % 2 == 0;
+      std::vector<std::uint8_t> cdr;
+      agnocast::serialize_with_schema(&text, schema, cdr);
+      writer.write_message(channel, t0 + i * 50'000'000, t0, cdr);
+    }
+    writer.close();
+  }
+  ASSERT_FALSE(agnocast::topic_info("/foreign_user"));
+  const pid_t player = agnocast_test::spawn({"agnocast-cli", "bag", "play", "foreign_user.mcap"},
+                                            "play_user.out", "play_user.err");
+  std::optional<agnocast::TopicInfo> info;
+  for (int i = 0; i < 200 && !(info = agnocast::topic_info("/foreign_user")); ++i) {
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_TRUE(info) << slurp("play_user.err");
+  EXPECT_EQ(info->type_name, "bag_live/msg/Text");
+  EXPECT_EQ(info->type_hash, agnocast::message_traits<bag_live::Text>::type_hash);
+  agnocast::Node node("foreign_user_sink");
+  std::mutex lock;
+  std::vector<std::uint64_t> seqs;
+  std::vector<std::string> problems;
+  auto subscription = node.create_subscription<bag_live::Text>(
+      "/foreign_user", agnocast::QoS(100), [&](const bag_live::Text& text) {
+        const std::lock_guard<std::mutex> guard(lock);
+        const std::uint64_t i = text.seq;
+        seqs.push_back(i);
+        std::vector<std::int32_t> expected;
+        for (std::int32_t v = 0; v < static_cast<std::int32_t>(i % 5); ++v) {
+          expected.push_back(v * 1000 - static_cast<std::int32_t>(i));
+        }
+        if (std::string(text.data.c_str()) != "text " + std::to_string(i) ||
+            std::vector<std::int32_t>(text.values.begin(), text.values.end()) != expected ||
+            text.even != (i % 2 == 0)) {
+          problems.push_back("message " + std::to_string(i) + " differs");
+        }
+      });
+  agnocast::SingleThreadedExecutor executor;
+  executor.add_node(node);
+  std::thread spinner([&] { executor.spin(); });
+  const int code = wait_exit(player);
+  std::this_thread::sleep_for(300ms);
+  executor.cancel();
+  spinner.join();
+  ASSERT_EQ(code, 0) << slurp("play_user.err") << slurp("play_user.out");
+  const std::lock_guard<std::mutex> guard(lock);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  // 60 messages over 2.95 s; the subscriber joined within the first second.
+  ASSERT_GE(seqs.size(), 30u) << slurp("play_user.out");
+  EXPECT_EQ(seqs.back(), 59u);
+  for (std::size_t i = 1; i < seqs.size(); ++i) EXPECT_EQ(seqs[i], seqs[i - 1] + 1);
 }
 
 // Hostile files: bag play names the file and exits 2 for one it cannot open,

@@ -103,9 +103,14 @@ void ErasedOps::destroy(void* message, std::uint16_t index) const noexcept {
         destroy_elements(at, field, field.array_length);
         break;
       case FieldShape::Sequence: {
-        const VectorSpan elements = sequence(at, field);
-        destroy_elements(elements.data, field, elements.count);
-        if (elements.data) detail::pool_deallocate(elements.data);
+        // This process's own vector, read as it is (no check may throw here).
+        const NativeContainerWords& words = native_container_words();
+        std::byte* begin = read_pointer(at, words.layout.vector_begin_offset);
+        std::byte* end = read_pointer(at, words.layout.vector_end_offset);
+        const std::size_t count =
+            begin ? static_cast<std::size_t>(end - begin) / field.element_size : 0;
+        destroy_elements(begin, field, count);
+        if (begin) detail::pool_deallocate(begin);
         std::memset(at, 0, field.size);
         break;
       }

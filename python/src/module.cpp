@@ -535,25 +535,16 @@ void set_field(const std::shared_ptr<Storage>& storage, std::byte* base, const S
   }
 }
 
-// agnocast.InvalidMessage, for the buffer getter (set when the module loads).
-PyObject*& invalid_message_type() {
-  static PyObject* type = nullptr;
-  return type;
-}
-
-// Sets the Python error for the exception being handled.
+// Sets the Python error for the exception being handled, through the same
+// translators every bound function's errors go through (ours first).
 void raise_current_exception() {
-  try {
-    throw;
-  } catch (py::error_already_set& error) {
-    error.restore();
-  } catch (const py::builtin_exception& error) {
-    error.set_error();
-  } catch (const InvalidMessage& error) {
-    PyErr_SetString(invalid_message_type(), error.what());
-  } catch (const std::exception& error) {
-    PyErr_SetString(PyExc_RuntimeError, error.what());
+  if (py::detail::apply_exception_translators(
+          py::detail::get_local_internals().registered_exception_translators) ||
+      py::detail::apply_exception_translators(
+          py::detail::get_internals().registered_exception_translators)) {
+    return;
   }
+  PyErr_SetString(PyExc_SystemError, "agnocast: an error no translator knows");
 }
 
 // What a Sequence's buffer view points its format, shape and strides at.
@@ -1021,7 +1012,6 @@ PYBIND11_MODULE(_core, m) {
   auto* sequence_type = reinterpret_cast<PyHeapTypeObject*>(sequence_class.ptr());
   sequence_type->as_buffer.bf_getbuffer = sequence_getbuffer;
   sequence_type->as_buffer.bf_releasebuffer = sequence_releasebuffer;
-  invalid_message_type() = invalid_message.ptr();
 
   py::enum_<CallbackGroupType>(m, "CallbackGroupType")
       .value("MutuallyExclusive", CallbackGroupType::MutuallyExclusive)

@@ -20,6 +20,7 @@
 #include "agnocast/schema_topic.hpp"
 #include "agnocast/signals.hpp"
 #include "bag/bag.hpp"
+#include "bag/definition_type.hpp"
 #include "standard_types.hpp"
 
 namespace agnocast::cli {
@@ -65,7 +66,7 @@ int bag_play(const BagPlayOptions& options, std::ostream& out) {
                        "' is not ros2msg schemas with cdr messages (encoding '" +
                        channel.message_encoding + "')");
     }
-    const std::string type_name = schema->second.name;
+    std::string type_name = schema->second.name;
     std::uint64_t type_hash = 0;
     std::vector<std::uint8_t> blob;
     std::optional<SchemaTopic> live;
@@ -89,12 +90,20 @@ int bag_play(const BagPlayOptions& options, std::ostream& out) {
       // generated headers lay it out, which is what its subscribers expect.
       type_hash = standard->hash;
       blob.assign(standard->schema.begin(), standard->schema.end());
-    }
-    if (blob.empty()) {
-      throw InputError(options.path + ": no layout known for topic '" + channel.topic + "' (" +
-                       type_name +
-                       ", not a standard type): start a subscriber of it first, or record the "
-                       "file with agnocast");
+    } else {
+      // Any other type: laid out from the definition the file carries, as
+      // agnocast-msggen lays out the same .msg files for its subscribers.
+      const std::vector<std::uint8_t>& text = schema->second.data;
+      try {
+        DefinitionType derived = type_from_definition(
+            type_name, std::string_view(reinterpret_cast<const char*>(text.data()), text.size()));
+        type_name = std::move(derived.type_name);
+        type_hash = derived.type_hash;
+        blob = std::move(derived.schema);
+      } catch (const InputError& error) {
+        throw InputError(options.path + ": topic '" + channel.topic + "' (" + type_name +
+                         "): " + error.what());
+      }
     }
     std::unique_ptr<SchemaPublisher> played;
     try {

@@ -25,6 +25,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "agnocast/limits.hpp"
@@ -71,6 +72,12 @@ struct Schema {
   ContainerLayout containers;
   std::vector<SchemaType> types;
 };
+
+// Throws SchemaError when `layout`, the one `type_name` was built with, is not
+// this process's: its containers cannot then be built or changed in place
+// here (`purpose` says what was attempted).
+void require_native_layout(const ContainerLayout& layout, std::string_view type_name,
+                           std::string_view purpose);
 
 // Bytes of one number or bool of this kind; 0 for strings, messages and opaque bytes.
 std::uint32_t primitive_size(FieldKind kind);

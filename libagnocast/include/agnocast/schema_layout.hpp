@@ -2,13 +2,13 @@
 // library this library was built with, found once by probing real containers.
 // A schema records the words a message's writer used (ContainerLayout); a
 // reader or writer that touches containers without their C++ type (the
-// renderer, the CDR writer and reader, Python) asks here whether that layout
-// is this process's, and where the words it does not record lie.
+// renderer, the CDR writer and reader, Python) compares it with this
+// process's (require_native_layout(), <agnocast/schema.hpp>) and asks here
+// where the words it does not record lie.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <string_view>
 
 namespace agnocast {
 
@@ -42,11 +42,5 @@ struct NativeContainerWords {
 // The layout of this process's standard library.
 const ContainerLayout& native_container_layout();
 const NativeContainerWords& native_container_words();
-
-// Throws SchemaError when `layout`, the one `type_name` was built with, is not
-// this process's: its containers cannot then be built or changed in place
-// here (`purpose` says what was attempted).
-void require_native_layout(const ContainerLayout& layout, std::string_view type_name,
-                           std::string_view purpose);
 
 }  // namespace agnocast

@@ -152,6 +152,17 @@ void check_nesting(const Schema& schema) {
 
 }  // namespace
 
+void require_native_layout(const ContainerLayout& layout, std::string_view type_name,
+                           std::string_view purpose) {
+  if (layout == native_container_layout()) return;
+  throw SchemaError("agnocast: " + std::string(type_name) +
+                    " was built with another standard library's container layout than this "
+                    "process's, so " +
+                    std::string(purpose) +
+                    " cannot lay out its vectors and strings; build both with the same compiler "
+                    "and standard library");
+}
+
 std::uint32_t primitive_size(FieldKind kind) {
   switch (kind) {
     case FieldKind::Bool:

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "agnocast/allocator.hpp"
-#include "agnocast/schema.hpp"
 
 namespace agnocast {
 namespace {
@@ -84,16 +83,5 @@ const NativeContainerWords& native_container_words() {
 }
 
 const ContainerLayout& native_container_layout() { return native_container_words().layout; }
-
-void require_native_layout(const ContainerLayout& layout, std::string_view type_name,
-                           std::string_view purpose) {
-  if (layout == native_container_layout()) return;
-  throw SchemaError("agnocast: " + std::string(type_name) +
-                    " was built with another standard library's container layout than this "
-                    "process's, so " +
-                    std::string(purpose) +
-                    " cannot lay out its vectors and strings; build both with the same compiler "
-                    "and standard library");
-}
 
 }  // namespace agnocast

@@ -65,6 +65,19 @@ pid_t start_recorder(const std::vector<std::string>& args) {
   return agnocast_test::spawn(argv, "record.out", "record.err");
 }
 
+// Runs `node`'s callbacks until `player` exits and a moment after (what it
+// published last is delivered); returns the player's exit status.
+int spin_until_exit(agnocast::Node& node, pid_t player) {
+  agnocast::SingleThreadedExecutor executor;
+  executor.add_node(node);
+  std::thread spinner([&] { executor.spin(); });
+  const int code = wait_exit(player);
+  std::this_thread::sleep_for(300ms);
+  executor.cancel();
+  spinner.join();
+  return code;
+}
+
 template <class T>
 bool wait_for_recorder(agnocast::Publisher<T>& publisher) {
   return publisher.wait_for_subscribers(1, 20s);
@@ -389,13 +402,7 @@ TEST_F(BagLive, AForeignFileOfAStandardTypePlaysWithoutASubscriberFirst) {
         const std::lock_guard<std::mutex> guard(lock);
         got.emplace_back(message.data.begin(), message.data.end());
       });
-  agnocast::SingleThreadedExecutor executor;
-  executor.add_node(node);
-  std::thread spinner([&] { executor.spin(); });
-  const int code = wait_exit(player);
-  std::this_thread::sleep_for(300ms);
-  executor.cancel();
-  spinner.join();
+  const int code = spin_until_exit(node, player);
   ASSERT_EQ(code, 0) << slurp("play.err") << slurp("play.out");
   const std::lock_guard<std::mutex> guard(lock);
   // 40 messages over 3.9 s; the subscriber joined within the first second.
@@ -473,13 +480,7 @@ TEST_F(BagLive, AForeignFileOfAUserTypePlaysFromItsDefinitionWithoutASubscriberF
           problems.push_back("message " + std::to_string(i) + " differs");
         }
       });
-  agnocast::SingleThreadedExecutor executor;
-  executor.add_node(node);
-  std::thread spinner([&] { executor.spin(); });
-  const int code = wait_exit(player);
-  std::this_thread::sleep_for(300ms);
-  executor.cancel();
-  spinner.join();
+  const int code = spin_until_exit(node, player);
   ASSERT_EQ(code, 0) << slurp("play_user.err") << slurp("play_user.out");
   const std::lock_guard<std::mutex> guard(lock);
   EXPECT_TRUE(problems.empty()) << problems.front();

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "agnocast/allocator.hpp"
+#include "agnocast/limits.hpp"
 #include "agnocast/message_traits.hpp"
 #include "agnocast/schema.hpp"
 #include "cli.hpp"
@@ -45,6 +46,11 @@ class DefinitionTypes {
     const std::string key = package + "/" + name;
     if (const auto built = built_.find(key); built != built_.end()) return *built->second;
     if (building_.contains(key)) throw InputError("message type " + key + " contains itself");
+    // Each level is a call deeper; readers refuse deeper schemas anyway.
+    if (building_.size() >= message_max_nesting) {
+      throw InputError("message type " + key + " nests messages more than " +
+                       std::to_string(message_max_nesting) + " deep");
+    }
     const auto text = texts_.find(key);
     if (text == texts_.end()) {
       throw InputError("the definition has no section for " + key + " (\"MSG: " + key + "\")");

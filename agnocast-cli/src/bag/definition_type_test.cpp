@@ -85,6 +85,13 @@ TEST(DefinitionType, RefusesWhatItCannotLayOut) {
                 .find("contains itself"),
             std::string::npos);
   EXPECT_NE(refused("demo/msg/A", "int32 x\nint33 y\n").find("demo/A.msg:2"), std::string::npos);
+  std::string chain = "L0 next\n";
+  for (int i = 0; i < 100000; ++i) {
+    chain += std::string(80, '=') + "\nMSG: demo/L" + std::to_string(i) + "\nL" +
+             std::to_string(i + 1) + " next\n";
+  }
+  EXPECT_NE(refused("demo/msg/A", chain).find("nests messages more than 32 deep"),
+            std::string::npos);
   EXPECT_NE(refused("not a type", "int32 x\n").find("not a message type name"), std::string::npos);
   EXPECT_NE(refused("demo/msg/A", "int32[0] x\n").find("bad array length '0'"), std::string::npos);
   EXPECT_NE(refused("demo/msg/A", "float64[1000000000] x\n").find("more than a message may"),

@@ -174,12 +174,6 @@ TEST_P(KernelRules, TheModuleFollowsThem) {
   if (runs > 1) std::printf("%d runs: the earlier ones were too slow to judge\n", runs);
 }
 
-std::vector<const Scenario*> every_scenario() {
-  std::vector<const Scenario*> all;
-  for (const Scenario& scenario : scenarios()) all.push_back(&scenario);
-  return all;
-}
-
 INSTANTIATE_TEST_SUITE_P(Table, KernelRules, ::testing::ValuesIn(every_scenario()),
                          [](const auto& info) { return info.param->name; });
 

@@ -234,6 +234,12 @@ Step kill(int process) {
 Step pass_watchdog() { return step_of(Step::Kind::pass_watchdog); }
 
 // Processes: 0 publishes, 1 subscribes, 2 publishes too (or subscribes).
+std::vector<const Scenario*> every_scenario() {
+  std::vector<const Scenario*> all;
+  for (const Scenario& scenario : scenarios()) all.push_back(&scenario);
+  return all;
+}
+
 const std::vector<Scenario>& scenarios() {
   static const std::vector<Scenario> table = {
       // Wake-ups.

@@ -174,6 +174,8 @@ struct Scenario {
 };
 
 const std::vector<Scenario>& scenarios();
+// The same, as pointers: the parameters of a test over the table.
+std::vector<const Scenario*> every_scenario();
 
 using MakeWorld = std::function<std::unique_ptr<World>(int processes)>;
 

@@ -11,6 +11,7 @@
 #include <geometry_msgs/msg/pose.hpp>
 #include <geometry_msgs/msg/transform.hpp>
 #include <geometry_msgs/msg/vector3.hpp>
+#include <iostream>
 #include <sensor_msgs/msg/image.hpp>
 #include <sensor_msgs/msg/nav_sat_fix.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
@@ -52,12 +53,18 @@ TEST(StandardSet, TypeNamesAreRos2s) {
             "unique_identifier_msgs/msg/UUID");
 }
 
-// The deepest type of the set still fits the kernel's schema bound.
+// The deepest type of the set still fits the kernel's schema bound, with
+// the .msg text of every type it nests.
 TEST(StandardSet, InteractiveMarkerUpdateHasAllItsNestedTypes) {
-  const agnocast::Schema schema = agnocast::parse_schema(
-      agnocast::schema_of<visualization_msgs::msg::InteractiveMarkerUpdate>());
+  const auto blob = agnocast::schema_of<visualization_msgs::msg::InteractiveMarkerUpdate>();
+  const agnocast::Schema schema = agnocast::parse_schema(blob);
+  std::cout << "InteractiveMarkerUpdate: " << schema.types.size() << " types, " << blob.size()
+            << " schema bytes\n";
   std::set<std::string> names;
-  for (const agnocast::SchemaType& type : schema.types) names.insert(type.name);
+  for (const agnocast::SchemaType& type : schema.types) {
+    names.insert(type.name);
+    EXPECT_FALSE(type.definition.empty()) << type.name;
+  }
   for (const char* name : {"visualization_msgs/msg/InteractiveMarker",
                            "visualization_msgs/msg/InteractiveMarkerControl",
                            "visualization_msgs/msg/Marker", "visualization_msgs/msg/MeshFile",

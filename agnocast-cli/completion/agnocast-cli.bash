@@ -50,7 +50,7 @@ _agnocast_cli() {
       if [[ $cur == -* || ${#words[@]} -ge 3 ]]; then
         case ${words[1]} in
           hz) candidates="--window --count --json --help" ;;
-          echo) candidates="--count --timeout --no-arrays --json --help" ;;
+          echo) candidates="--count --timeout --no-arrays --definition --json --help" ;;
           *) candidates="--json --help" ;;
         esac
       else

@@ -50,7 +50,8 @@ struct EchoOptions {
   std::optional<std::size_t> count;  // stop after this many (exit 0)
   std::optional<double> timeout_s;   // give up (exit 1) when fewer arrived by then
   bool show_arrays = true;
-  bool json = false;  // JSON Lines instead of YAML-like text
+  bool json = false;        // JSON Lines instead of YAML-like text
+  bool definition = false;  // print the type's .msg definition instead, and exit
 };
 // A subcommand of `topic`.
 void set_topic_echo_command(CLI::App& topic, Context& context);

@@ -1,8 +1,10 @@
-// agnocast-cli topic echo TOPIC [--count N] [--timeout SEC] [--no-arrays] [--json]
+// agnocast-cli topic echo TOPIC [--count N] [--timeout SEC] [--no-arrays] [--definition] [--json]
 #include <sstream>
 
+#include "agnocast/cdr.hpp"
 #include "agnocast/message_render.hpp"
 #include "agnocast/naming.hpp"
+#include "agnocast/schema_definition.hpp"
 #include "commands.hpp"
 
 namespace agnocast::cli {
@@ -24,6 +26,25 @@ std::string seconds_text(double seconds) {
 }  // namespace
 
 int topic_echo(InspectionSource& source, const EchoOptions& options, std::ostream& out) {
+  if (options.definition) {
+    const Schema schema = source.topic_schema(options.topic);
+    std::string text;
+    try {
+      text = ros2msg_definition(schema);
+    } catch (const cdr::Error& error) {
+      throw CliError("topic '" + options.topic + "' has no .msg definition: " + error.what());
+    }
+    if (options.json) {
+      out << nlohmann::json{{"topic", options.topic},
+                            {"type", schema.types.at(0).name},
+                            {"definition", text}}
+                 .dump()
+          << '\n';
+    } else {
+      out << text;
+    }
+    return exit_success;
+  }
   const std::unique_ptr<MessageTap> tap = source.subscribe(options.topic);
   const double start = source.now_seconds();
   std::size_t received = 0;
@@ -74,6 +95,9 @@ void set_topic_echo_command(CLI::App& topic, Context& context) {
   echo->add_flag_callback(
       "--no-arrays", [options] { options->show_arrays = false; },
       "Show the length of arrays and sequences instead of their elements");
+  echo->add_flag("--definition", options->definition,
+                 "Print the type's .msg definition (with every type it uses, as rosbag2 writes "
+                 "it) and exit");
   bind_command(*echo, context, {.stream = [&context, options](std::ostream& out) {
     options->json = context.json;
     return topic_echo(context.source, *options, out);

@@ -241,6 +241,36 @@ TEST_F(TopicEcho, HostilePointersPrintMarkers) {
                    "\n");
 }
 
+TEST_F(TopicEcho, DefinitionPrintsTheTypesMsgTextsWithoutSubscribing) {
+  const std::string separator(80, '=');
+  const Outcome declared = run({"/chatter", "--definition"});
+  EXPECT_EQ(declared.code, 0) << declared.err;
+  // A type declared in C++ has no .msg text: its fields stand for it.
+  EXPECT_EQ(declared.out, "int32 id\nstring label\necho_test/Point origin\nfloat32[] values\n" +
+                              separator + "\nMSG: echo_test/Point\nfloat64 x\nfloat64 y\n");
+
+  // A generated type's schema carries its .msg file, constants and comments too.
+  TypeDescriptor point = message_traits<echo_test::Point>::descriptor;
+  const std::string text = "# where\nint8 ORIGIN=0\nfloat64 x  # east\nfloat64 y\n";
+  point.definition = text;
+  const std::vector<std::uint8_t> blob = build_schema(point);
+  TopicInfo topic;
+  topic.name = "/point";
+  source_.topics.push_back(topic);
+  source_.streams["/point"].schema = blob;
+  const Outcome generated = run({"/point", "--definition", "--json"});
+  EXPECT_EQ(generated.code, 0) << generated.err;
+  EXPECT_EQ(
+      nlohmann::json::parse(generated.out),
+      (nlohmann::json{{"topic", "/point"}, {"type", "echo_test/msg/Point"}, {"definition", text}}));
+  EXPECT_TRUE(source_.streams["/point"].messages.empty());
+
+  source_.streams.erase("/point");
+  const Outcome none = run({"/point", "--definition"});
+  EXPECT_EQ(none.code, 1);
+  EXPECT_NE(none.err.find("/point has no schema"), std::string::npos) << none.err;
+}
+
 TEST_F(TopicEcho, UsageErrorsExitTwo) {
   EXPECT_EQ(run({}).code, 2);
   EXPECT_EQ(run({"/chatter", "--count", "0"}).code, 2);

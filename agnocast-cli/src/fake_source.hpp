@@ -118,6 +118,12 @@ class FakeSource : public InspectionSource {
     if (stream == streams.end()) throw TopicWithoutSchema(topic + " has no schema");
     return std::make_unique<FakeTap>(stream->second);
   }
+  Schema topic_schema(const std::string& topic) override {
+    if (!topic_info(topic)) throw TopicWithoutSchema("no publisher or subscriber uses " + topic);
+    const auto stream = streams.find(topic);
+    if (stream == streams.end()) throw TopicWithoutSchema(topic + " has no schema");
+    return parse_schema(stream->second.schema);
+  }
   bool stop_requested() override { return stop; }
   double now_seconds() override { return clock; }
   double unix_time() override { return unix_clock; }

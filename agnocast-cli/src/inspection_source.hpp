@@ -77,6 +77,9 @@ class InspectionSource {
   // Subscribes to `topic` with the type its endpoints registered; throws
   // agnocast::TopicWithoutSchema when it has no endpoint or no schema.
   virtual std::unique_ptr<MessageTap> subscribe(const std::string& topic) = 0;
+  // The schema `topic`'s endpoints registered, without subscribing; throws
+  // like subscribe().
+  virtual Schema topic_schema(const std::string& topic) = 0;
   // True once SIGINT or SIGTERM asked a streaming command to stop.
   virtual bool stop_requested() = 0;
 

@@ -19,6 +19,7 @@
 #include "agnocast/naming.hpp"
 #include "agnocast/node.hpp"
 #include "agnocast/schema_subscriber.hpp"
+#include "agnocast/schema_topic.hpp"
 #include "agnocast/signals.hpp"
 #include "inspection_source.hpp"
 
@@ -125,6 +126,9 @@ class SystemSource final : public InspectionSource {
   std::unique_ptr<MessageTap> subscribe(const std::string& topic) override {
     install_signal_handlers();
     return std::make_unique<SystemTap>(topic);
+  }
+  Schema topic_schema(const std::string& topic) override {
+    return resolve_schema_topic(topic).schema;
   }
   bool stop_requested() override { return !agnocast::ok(); }
 

@@ -1,21 +1,27 @@
 // Writes an MCAP file as bag record does (schema-driven CDR and .msg text,
 // rosbag2's channel metadata) from messages built in a pool here, and a JSON
-// file of the values each message holds, rendered from the schema. Readers
+// file of the values each message holds, rendered from the schema, and of the
+// .msg files a user type's definition must hold word for word. Readers
 // written elsewhere (tests/mcap-readers) check the one against the other.
 //   agnocast_bag_sample_writer OUT.mcap EXPECTED.json zstd|lz4|none
 #include <agnocast/agnocast.hpp>
 #include <agnocast/message_render.hpp>
 #include <agnocast/schema_cdr.hpp>
+#include <agnocast/schema_definition.hpp>
+#include <algorithm>
 #include <fstream>
+#include <golden_msgs/msg/wheel.hpp>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sensor_msgs/msg/imu.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
+#include <sstream>
 
 #include "agnocast/mcap/writer.hpp"
 #include "bag/bag.hpp"
+#include "bag/qos_profiles.hpp"
 #include "kernel/runtime.hpp"
-#include "standard_msg_texts.hpp"
 
 namespace bag_sample {
 
@@ -51,7 +57,7 @@ class SampleFile {
   template <class T>
   std::uint16_t topic(const std::string& name) {
     const agnocast::Schema schema = agnocast::parse_schema(agnocast::schema_of<T>());
-    const std::string text = agnocast::ros2msg_definition(schema, agnocast::standard_msg_text);
+    const std::string text = agnocast::ros2msg_definition(schema);
     const auto schema_id =
         writer_.add_schema(schema.types[0].name, "ros2msg", {text.begin(), text.end()});
     return writer_.add_channel(
@@ -73,16 +79,32 @@ class SampleFile {
          {"value", nlohmann::json::parse(agnocast::render_message_json(&value, schema))}});
   }
 
+  // The schema of `type_name` must be these texts: its own, then each type it uses.
+  void expect_definition(const std::string& type_name, const std::string& own,
+                         const std::map<std::string, std::string>& uses) {
+    definitions_.push_back({{"schema", type_name}, {"own", own}, {"uses", uses}});
+  }
+
   void close(const std::string& expected_path) {
     writer_.close();
-    std::ofstream(expected_path) << expected_.dump(1) << '\n';
+    const nlohmann::json expected{{"messages", expected_}, {"definitions", definitions_}};
+    std::ofstream(expected_path) << expected.dump(1) << '\n';
   }
 
  private:
   agnocast::mcap::Writer writer_;
   std::uint64_t time_ = 1'700'000'000'000'000'000;
   nlohmann::json expected_ = nlohmann::json::array();
+  nlohmann::json definitions_ = nlohmann::json::array();
 };
+
+std::string golden_msg_file(const char* name) {
+  std::ifstream file(std::string(GOLDEN_MSGS_DIR) + "/" + name + ".msg");
+  std::stringstream text;
+  text << file.rdbuf();
+  if (text.str().empty()) throw std::runtime_error(std::string("cannot read ") + name + ".msg");
+  return text.str();
+}
 
 }  // namespace
 
@@ -103,6 +125,11 @@ int main(int argc, char** argv) {
   const auto points = file.topic<sensor_msgs::msg::PointCloud2>("/points");
   const auto chatter = file.topic<bag_sample::Text>("/chatter");
   const auto imu = file.topic<sensor_msgs::msg::Imu>("/imu");
+  // A user's type with constants, comments, bounds and a same-package type:
+  // recorded, its definition is its .msg files as they are, as rosbag2 writes it.
+  const auto wheels = file.topic<golden_msgs::msg::Wheel>("/wheel");
+  file.expect_definition("golden_msgs/msg/Wheel", golden_msg_file("Wheel"),
+                         {{"golden_msgs/Tire", golden_msg_file("Tire")}});
   for (int i = 0; i < 5; ++i) {
     auto* cloud = in_pool<sensor_msgs::msg::PointCloud2>();
     cloud->header.stamp.sec = 1700000000 + i;
@@ -144,6 +171,21 @@ int main(int argc, char** argv) {
     reading->orientation_covariance[0] = 0.5;
     reading->orientation_covariance[8] = 2.0;
     file.message(imu, "/imu", *reading);
+
+    auto* wheel = in_pool<golden_msgs::msg::Wheel>();
+    wheel->header.frame_id = "wheel_" + std::to_string(i);
+    wheel->tire.pressure_kpa = static_cast<std::uint16_t>(200 + i);
+    wheel->tire.brand = "a brand name longer than a small string buffer";
+    wheel->radius = 0.25 + i;
+    wheel->speeds.assign(static_cast<std::size_t>(i), 1.5F);
+    wheel->tags.push_back(("t" + std::to_string(i)).c_str());
+    wheel->flags = {1, 0, static_cast<std::uint8_t>(i % 2)};
+    wheel->enabled = i % 2 == 0;
+    wheel->spares[1].brand = "spare";
+    if (i > 0) wheel->axes.resize(static_cast<std::size_t>(std::min(i, 3)));
+    wheel->status = golden_msgs::msg::Wheel::MODE_DRIVE;
+    wheel->odometer = 1'000'000'000ULL * static_cast<std::uint64_t>(i);
+    file.message(wheels, "/wheel", *wheel);
   }
   file.close(argv[2]);
   return 0;

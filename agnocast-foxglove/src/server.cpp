@@ -21,6 +21,7 @@
 #include "agnocast/inspect.hpp"
 #include "agnocast/node.hpp"
 #include "agnocast/schema_cdr.hpp"
+#include "agnocast/schema_definition.hpp"
 #include "agnocast/schema_publisher.hpp"
 #include "agnocast/schema_subscription.hpp"
 #include "agnocast/schema_topic.hpp"
@@ -29,7 +30,6 @@
 #include "agnocast_service/notify.hpp"
 #include "agnocast_service/watchdog.hpp"
 #include "protocol.hpp"
-#include "standard_msg_texts.hpp"
 
 namespace agnocast::foxglove {
 namespace {
@@ -530,7 +530,6 @@ class Server final : public WebSocketHandler {
   // server's uses it, with bag record's definitions.
   TopicWatcherOptions watched_topics() {
     TopicWatcherOptions watched;
-    watched.text_of = standard_msg_text;
     if (options_.topics) {
       watched.wanted = [this](const std::string& name) {
         return std::regex_match(name, *options_.topics);

@@ -86,6 +86,38 @@ void write_struct(std::string& out, const MessageSpec& spec) {
   out += "};\n";
 }
 
+// `text` as C++ string literals, one per line of it, each on a line of its
+// own after `indent`; every byte that is not printable ASCII as an octal
+// escape, so the header is ASCII whatever the .msg file's encoding.
+std::string string_literal(std::string_view text, std::string_view indent) {
+  if (text.empty()) return "\"\"";
+  std::string out;
+  bool line_open = false;
+  for (const char c : text) {
+    if (!line_open) {
+      if (!out.empty()) out += fmt::format("\n{}", indent);
+      out += '"';
+      line_open = true;
+    }
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n\"";
+      line_open = false;
+    } else if (c == '"' || c == '\\' || c == '?') {  // '?': no trigraph, whatever the mode
+      out += '\\';
+      out += c;
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (byte < 0x20 || byte >= 0x7f) {
+      out += fmt::format("\\{:03o}", byte);
+    } else {
+      out += c;
+    }
+  }
+  if (line_open) out += '"';
+  return out;
+}
+
 void write_traits(std::string& out, const MessageSpec& spec) {
   out += fmt::format(
       "template <>\n"
@@ -109,12 +141,15 @@ void write_traits(std::string& out, const MessageSpec& spec) {
         "{0}){1}),\n",
         field.name, bounds.empty() ? "" : ", {" + bounds + "}");
   }
-  out +=
-      "  };\n"
+  out += fmt::format(
+      "  }};\n"
+      "  static constexpr std::string_view definition =\n"
+      "      {};\n"
       "  static constexpr agnocast::TypeDescriptor descriptor =\n"
-      "      agnocast::describe_type<Message>(type_name, fields);\n"
+      "      agnocast::describe_type<Message>(type_name, fields, definition);\n"
       "  static constexpr std::uint64_t type_hash = descriptor.hash;\n"
-      "};\n";
+      "}};\n",
+      string_literal(spec.text, "      "));
 }
 
 void write_bound_checks(std::string& out, const MessageSpec& spec, const Field& field) {

@@ -30,6 +30,27 @@ TEST(HeaderWriter, SnakeCaseFollowsRos2) {
   EXPECT_EQ(header_path("wheel_msgs", "Wheel"), "wheel_msgs/msg/wheel.hpp");
 }
 
+// The .msg text as string literals that say exactly its bytes: quotes,
+// backslashes, '?' (no trigraph), tabs, control and non-ASCII bytes escaped,
+// one literal per line, and a last line without its newline kept so.
+TEST(HeaderWriter, DefinitionIsALiteralOfTheFilesBytes) {
+  MessageSpec spec;
+  spec.package = "edge_msgs";
+  spec.name = "Edge";
+  spec.text = "# \"q\" \\ ?\?= \t\r gr\xc3\xbc\xc3\x9f\xc3\xa9\nint32 x\n\nint32 y";
+  const std::string header = write_header(spec);
+  EXPECT_NE(header.find(
+                "  static constexpr std::string_view definition =\n"
+                "      \"# \\\"q\\\" \\\\ \\?\\?= \\t\\015 gr\\303\\274\\303\\237\\303\\251\\n\"\n"
+                "      \"int32 x\\n\"\n"
+                "      \"\\n\"\n"
+                "      \"int32 y\";\n"),
+            std::string::npos)
+      << header;
+  spec.text.clear();
+  EXPECT_NE(write_header(spec).find("definition =\n      \"\";\n"), std::string::npos);
+}
+
 // Regenerate the expected files with: agnocast-msggen --package golden_msgs
 //   --output-dir tests/golden/expected --include std_msgs=... --include geometry_msgs=...
 //   tests/golden/golden_msgs/msg/*.msg

@@ -74,6 +74,7 @@ struct MessageSpec {
   std::string package;
   std::string name;
   std::string file;
+  std::string text;                   // the file as read: its definition for bags and tools
   std::vector<std::string> comments;  // the block before the first member
   std::vector<Constant> constants;
   std::vector<Field> fields;

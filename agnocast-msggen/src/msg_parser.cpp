@@ -301,7 +301,9 @@ MessageSpec parse_message(std::string_view text, const std::string& file,
     throw InputError(file, 0,
                      fmt::format("bad message name '{}': CamelCase letters and digits", name));
   }
-  return Parser(file, package, name).run(text);
+  MessageSpec spec = Parser(file, package, name).run(text);
+  spec.text = std::string(text);
+  return spec;
 }
 
 }  // namespace msggen

@@ -1,9 +1,11 @@
 // The generated golden headers compiled: names, defaults, constants, traits, hash.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <golden_msgs/msg/empty.hpp>
 #include <golden_msgs/msg/wheel.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
+#include <sstream>
 #include <type_traits>
 
 #include "kernel/runtime.hpp"
@@ -58,6 +60,16 @@ TEST(GeneratedMessage, ConstantsAndDefaults) {
   EXPECT_EQ(wheel.tire.pressure_kpa, 220);
   EXPECT_EQ(wheel.odometer, UINT64_MAX);
   EXPECT_EQ(wheel.status, 0);
+}
+
+// The .msg file travels with the type, byte for byte, for bags and tools.
+TEST(GeneratedMessage, DefinitionIsTheMsgFileAsItIs) {
+  std::ifstream file(std::string(GOLDEN_MSGS_DIR) + "/Wheel.msg", std::ios::binary);
+  std::stringstream text;
+  text << file.rdbuf();
+  ASSERT_FALSE(text.str().empty());
+  EXPECT_EQ(agnocast::message_traits<golden_msgs::msg::Wheel>::definition, text.str());
+  EXPECT_EQ(agnocast::message_traits<golden_msgs::msg::Wheel>::descriptor.definition, text.str());
 }
 
 TEST(GeneratedMessage, DescriptorMatchesTheStruct) {

@@ -49,6 +49,11 @@ class MessageMeta(_CoreMeta):
         return {name: cls.__dict__[name] for name in cls.__dict__.get("_constants", ())}
 
     @property
+    def definition(cls):
+        """The .msg text of the type and of every type it uses, as rosbag2 writes it."""
+        return _type_of(cls).definition
+
+    @property
     def schema(cls):
         """The schema blob of the C++ type (the one the kernel keeps per topic)."""
         return _type_of(cls).schema

@@ -26,6 +26,7 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/log.hpp"
 #include "agnocast/schema.hpp"
+#include "agnocast/schema_definition.hpp"
 #include "agnocast/schema_subscriber.hpp"
 #include "erased_message.hpp"
 #include "log_forwarder.hpp"
@@ -876,6 +877,15 @@ PYBIND11_MODULE(_core, m) {
                                const auto blob = c.schema.blob();
                                return py::bytes(reinterpret_cast<const char*>(blob.data()),
                                                 blob.size());
+                             })
+      .def_property_readonly("definition",
+                             [](const MessageClass& c) {
+                               // Another program's text: a byte that is not UTF-8 must not raise.
+                               const std::string text = ros2msg_definition(c.schema.schema());
+                               PyObject* decoded = PyUnicode_DecodeUTF8(
+                                   text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
+                               if (decoded == nullptr) throw py::error_already_set();
+                               return py::reinterpret_steal<py::str>(decoded);
                              })
       .def_property_readonly("fields",
                              [](const MessageClass& c) {

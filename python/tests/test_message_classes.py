@@ -32,6 +32,17 @@ def test_constants_of_a_user_package_keep_their_types_and_text():
                                      "ODOMETER_MAX", "LABEL", "GREETING"]
 
 
+def test_definition_is_the_msg_files_own_text():
+    text = Wheel.definition
+    assert text.startswith("# A user message for the Python interop tests.\n"
+                           "int8 MODE_REVERSE=-1\nfloat32 MAX_SPEED=2.5\n")
+    assert 'string GREETING="grüße"\n' in text
+    assert "\n" + "=" * 80 + "\nMSG: std_msgs/Header\n" in text
+    assert PointField.definition.startswith("# How one field of each point is laid out in "
+                                            "PointCloud2.data.\n\n# Values of datatype\n"
+                                            "uint8 INT8=1\n")
+
+
 def test_constants_are_read_only():
     with pytest.raises(AttributeError):
         PointField.FLOAT32 = 9

@@ -2,7 +2,8 @@
 // @mcap/core's indexed reader (through the summary and indexes) and streamed
 // reader (every record, CRCs checked), and decodes every message with
 // @foxglove/rosmsg (the schema's .msg text) and @foxglove/rosmsg2-serialization
-// (the CDR), comparing each with the values the writer says it wrote.
+// (the CDR), comparing each with the values the writer says it wrote, and each
+// definition the writer names with the .msg files it must hold word for word.
 //   node check-mcap.mjs FILE.mcap EXPECTED.json
 import { readFile } from "node:fs/promises";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
@@ -32,6 +33,8 @@ function fail(message) {
 
 // Compares a decoded value with the expected JSON value, field by field.
 function compare(actual, expected, where) {
+  // bool[] travels as bytes in agnocast's schema (a vector<bool> packs bits).
+  if (typeof actual === "boolean" && typeof expected === "number") actual = Number(actual);
   if (typeof actual === "bigint") {
     if (actual !== BigInt(expected)) fail(`${where}: ${actual} != ${expected}`);
     return;
@@ -64,7 +67,7 @@ function compare(actual, expected, where) {
 }
 
 const bytes = new Uint8Array(await readFile(file));
-const expected = JSON.parse(await readFile(expectedFile, "utf8"));
+const { messages: expected, definitions } = JSON.parse(await readFile(expectedFile, "utf8"));
 
 function decoderFor(schema) {
   if (schema.encoding !== "ros2msg") fail(`schema ${schema.name}: encoding ${schema.encoding}`);
@@ -146,8 +149,30 @@ for (const schema of schemas.values()) {
 }
 if (pointFieldSchemas === 0) fail("no schema uses sensor_msgs/PointField");
 
+// A user type's definition is its .msg files as they are (constants, comments
+// and blank lines kept), joined as rosbag2 joins them.
+const separator = "=".repeat(80);
+for (const want of definitions) {
+  const schema = [...schemas.values()].find((s) => s.name === want.schema);
+  if (!schema) {
+    fail(`no schema ${want.schema}`);
+    continue;
+  }
+  const text = new TextDecoder().decode(schema.data);
+  const sections = text.split(`${separator}\n`);
+  if (sections[0] !== want.own) fail(`${want.schema}: its own text differs from its .msg file:\n${sections[0]}`);
+  for (const [name, own] of Object.entries(want.uses)) {
+    const section = sections.find((s) => s.startsWith(`MSG: ${name}\n`));
+    if (section === undefined) fail(`${want.schema}: no section MSG: ${name}`);
+    else if (section !== `MSG: ${name}\n${own}`) fail(`${want.schema}: ${name}'s text differs from its .msg file`);
+  }
+  const parsed = parse(text, { ros2: true });
+  const constant = parsed[0].definitions.find((d) => d.isConstant && d.name === "MODE_DRIVE");
+  if (!constant || Number(constant.value) !== 1) fail(`${want.schema}: no constant MODE_DRIVE = 1`);
+}
+
 if (failures > 0) {
   console.error(`${file}: ${failures} failures`);
   process.exit(1);
 }
-console.log(`${file}: ${expected.length} messages read back by @mcap/core (indexed and streamed) and decoded by @foxglove/rosmsg2-serialization, constants seen`);
+console.log(`${file}: ${expected.length} messages read back by @mcap/core (indexed and streamed) and decoded by @foxglove/rosmsg2-serialization, constants seen, ${definitions.length} user definitions equal to their .msg files`);

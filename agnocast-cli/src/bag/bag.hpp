@@ -55,7 +55,4 @@ int bag_play(const BagPlayOptions& options, std::ostream& out);
 // ending in '/'; created).
 std::string bag_output_path(const std::string& output, double unix_seconds);
 
-// rosbag2's offered_qos_profiles for the publishers (depth, transient_local).
-std::string offered_qos_profiles(const std::vector<std::pair<std::uint32_t, bool>>& publishers);
-
 }  // namespace agnocast::cli

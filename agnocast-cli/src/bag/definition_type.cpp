@@ -194,6 +194,7 @@ class DefinitionTypes {
     type.align = static_cast<std::uint32_t>(align);
     type.fields = fields;
     type.hash = detail::declared_type_hash(type.name, type.size, type.align, type.fields);
+    type.definition = texts_.at(spec.package + "/" + spec.name);  // what the file says of it
     return type;
   }
 

@@ -9,18 +9,17 @@
 #include <string>
 
 #include "agnocast/schema.hpp"
-#include "agnocast/schema_cdr.hpp"
+#include "agnocast/schema_definition.hpp"
 #include "cli.hpp"
 #include "golden_msgs/msg/wheel.hpp"
-#include "standard_msg_texts.hpp"
 #include "standard_types.hpp"
 
 namespace agnocast::cli {
 namespace {
 
-// What bag record writes for a type: its .msg texts where known.
+// What bag record writes for a type: the .msg texts its schema carries.
 std::string recorded_definition(const std::vector<std::uint8_t>& schema) {
-  return ros2msg_definition(parse_schema(schema), standard_msg_text);
+  return ros2msg_definition(parse_schema(schema));
 }
 
 TEST(DefinitionType, EveryStandardTypeIsLaidOutAsItsGeneratedHeader) {
@@ -56,13 +55,12 @@ TEST(DefinitionType, AUserTypeWithConstantsBoundsAndNestingMatchesItsGeneratedHe
     text << file.rdbuf();
     texts["golden_msgs/msg/" + std::string(name)] = text.str();
   }
-  std::map<std::string, std::string_view, std::less<>> views(texts.begin(), texts.end());
   const auto schema = schema_of<golden_msgs::msg::Wheel>();
-  const std::string definition = ros2msg_definition(
-      parse_schema(schema), [&](std::string_view type) -> const std::string_view* {
-        const auto found = views.find(type);
-        return found != views.end() ? &found->second : standard_msg_text(type);
-      });
+  const std::string definition = ros2msg_definition(parse_schema(schema));
+  ASSERT_EQ(definition.rfind(texts["golden_msgs/msg/Wheel"], 0), 0U) << definition;
+  ASSERT_NE(definition.find("\nMSG: golden_msgs/Tire\n" + texts["golden_msgs/msg/Tire"]),
+            std::string::npos)
+      << definition;
   ASSERT_NE(definition.find("bool[] flags"), std::string::npos) << definition;
   ASSERT_NE(definition.find("uint8 MODE_DRIVE=1"), std::string::npos) << definition;
   const DefinitionType derived = type_from_definition("golden_msgs/msg/Wheel", definition);

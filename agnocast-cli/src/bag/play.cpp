@@ -3,7 +3,9 @@
 // Each channel is published with the type a compiled subscriber expects: the
 // type name, layout hash and schema of the topic's live endpoints, or, when
 // none exists yet, those bag record stored in the channel's metadata; a
-// SchemaPublisher turns each message's CDR back into the message.
+// SchemaPublisher turns each message's CDR back into the message. Each
+// publisher offers what the recorded ones offered (offered_qos_profiles):
+// transient local and its depth, for subscribers that start after the player.
 #include <chrono>
 #include <map>
 #include <memory>
@@ -21,6 +23,7 @@
 #include "agnocast/signals.hpp"
 #include "bag/bag.hpp"
 #include "bag/definition_type.hpp"
+#include "bag/qos_profiles.hpp"
 #include "standard_types.hpp"
 
 namespace agnocast::cli {
@@ -107,7 +110,11 @@ int bag_play(const BagPlayOptions& options, std::ostream& out) {
     }
     std::unique_ptr<SchemaPublisher> played;
     try {
-      played = std::make_unique<SchemaPublisher>(node, channel.topic, QoS(10), type_name, type_hash,
+      // A late subscriber gets what it would have got from the recorded publishers.
+      const auto profiles = channel.metadata.find("offered_qos_profiles");
+      const QoS qos = played_qos(
+          profiles != channel.metadata.end() ? std::string_view(profiles->second) : "", 10);
+      played = std::make_unique<SchemaPublisher>(node, channel.topic, qos, type_name, type_hash,
                                                  std::move(blob));
     } catch (const SchemaError& error) {
       throw InputError("topic '" + channel.topic + "': " + error.what());

@@ -25,12 +25,13 @@
 #include "agnocast/mcap/writer.hpp"
 #include "agnocast/node.hpp"
 #include "agnocast/schema_cdr.hpp"
+#include "agnocast/schema_definition.hpp"
 #include "agnocast/schema_subscription.hpp"
 #include "agnocast/signals.hpp"
 #include "agnocast/topic_watcher.hpp"
 #include "agnocast/version.hpp"
 #include "bag/bag.hpp"
-#include "standard_msg_texts.hpp"
+#include "bag/qos_profiles.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -90,7 +91,6 @@ std::string size_text(double bytes) {
 
 TopicWatcherOptions recorded_topics() {
   TopicWatcherOptions options;
-  options.text_of = standard_msg_text;
   options.publishers_only = true;
   return options;
 }
@@ -180,9 +180,8 @@ class Recorder {
             take(*raw, message, info);
           });
       topic->type = topic->subscription->type_name();
-      // The standard types' own .msg text (constants and comments too), as
-      // rosbag2 writes it; other types' fields as the schema gives them.
-      topic->definition = ros2msg_definition(topic->subscription->schema(), standard_msg_text);
+      // Each type's own .msg text (constants and comments too), as rosbag2 writes it.
+      topic->definition = ros2msg_definition(topic->subscription->schema());
     } catch (const std::exception& error) {
       problem = error.what();
       return false;
@@ -399,22 +398,6 @@ std::string bag_output_path(const std::string& output, double unix_seconds) {
     return (fs::path(output) / name).string();
   }
   return output;
-}
-
-std::string offered_qos_profiles(const std::vector<std::pair<std::uint32_t, bool>>& publishers) {
-  // rosbag2's YAML, with rmw's numbers: history 1 keep last, reliability 1
-  // reliable, durability 1 transient local or 2 volatile, liveliness 1
-  // automatic; the other policies infinite (rmw's default).
-  const std::string infinite = "    sec: 2147483647\n    nsec: 4294967295\n";
-  std::string text;
-  for (const auto& [depth, transient_local] : publishers) {
-    text += "- history: 1\n  depth: " + std::to_string(depth) +
-            "\n  reliability: 1\n  durability: " + (transient_local ? "1" : "2") +
-            "\n  deadline:\n" + infinite + "  lifespan:\n" + infinite +
-            "  liveliness: 1\n  liveliness_lease_duration:\n" + infinite +
-            "  avoid_ros_namespace_conventions: false\n";
-  }
-  return text;
 }
 
 int bag_record(const BagRecordOptions& options, std::ostream& out) {

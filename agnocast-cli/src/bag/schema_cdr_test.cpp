@@ -5,18 +5,20 @@
 
 #include <agnocast/detail/message.hpp>
 #include <agnocast/schema_cdr.hpp>
+#include <agnocast/schema_definition.hpp>
 #include <algorithm>
+#include <fstream>
 #include <geometry_msgs/msg/transform_stamped.hpp>
 #include <memory>
 #include <sensor_msgs/msg/imu.hpp>
 #include <sensor_msgs/msg/laser_scan.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "kernel/runtime.hpp"
-#include "standard_msg_texts.hpp"
 #include "standard_types.hpp"
 
 namespace {
@@ -120,9 +122,19 @@ TEST(SchemaCdr, CheckedReadsOnlyThePool) {
   agnocast::detail::free_message_memory(loan);
 }
 
+// A standard .msg file as it is in the source tree.
+std::string msg_file(const std::string& package, const std::string& name) {
+  std::ifstream file(std::string(MESSAGES_DIR) + "/" + package + "/msg/" + name + ".msg");
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+// A type declared in C++ has no .msg text: its fields are written from the schema.
 TEST(SchemaCdr, Ros2msgDefinitionListsEveryTypeOnceInRosbag2Layout) {
-  const agnocast::Schema schema =
+  agnocast::Schema schema =
       agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::PointCloud2>());
+  for (agnocast::SchemaType& type : schema.types) type.definition.clear();
   const std::string separator(80, '=');
   const std::string expected =
       "std_msgs/Header header\n"
@@ -154,8 +166,8 @@ TEST(SchemaCdr, Ros2msgDefinitionListsEveryTypeOnceInRosbag2Layout) {
 }
 
 TEST(SchemaCdr, FixedArraysHaveTheirLengthInTheDefinition) {
-  const agnocast::Schema schema =
-      agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::Imu>());
+  agnocast::Schema schema = agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::Imu>());
+  for (agnocast::SchemaType& type : schema.types) type.definition.clear();
   const std::string text = agnocast::ros2msg_definition(schema);
   EXPECT_NE(text.find("float64[9] orientation_covariance\n"), std::string::npos) << text;
   EXPECT_NE(text.find("MSG: geometry_msgs/Quaternion\n"), std::string::npos) << text;
@@ -163,23 +175,23 @@ TEST(SchemaCdr, FixedArraysHaveTheirLengthInTheDefinition) {
   EXPECT_EQ(text.find("MSG: geometry_msgs/Vector3\n"), text.rfind("MSG: geometry_msgs/Vector3\n"));
 }
 
-// With the standard texts compiled in, each standard type's definition is its
-// whole .msg file, constants and comments included, as rosbag2 writes it.
+// The schema carries each type's .msg file as agnocast-msggen read it, so
+// the definition is the whole file, constants and comments included, as
+// rosbag2 writes it.
 TEST(SchemaCdr, StandardTypesKeepTheirConstantsAndComments) {
   const agnocast::Schema schema =
       agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::PointCloud2>());
-  const std::string text = agnocast::ros2msg_definition(schema, agnocast::standard_msg_text);
-  const std::string_view* point_field = agnocast::standard_msg_text("sensor_msgs/msg/PointField");
-  ASSERT_NE(point_field, nullptr);
+  const std::string text = agnocast::ros2msg_definition(schema);
+  const std::string point_field = msg_file("sensor_msgs", "PointField");
+  ASSERT_FALSE(point_field.empty());
   EXPECT_NE(text.find("uint8 FLOAT32=7\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("\nMSG: sensor_msgs/PointField\n" + std::string(*point_field)),
-            std::string::npos)
-      << text;
-  const std::string_view* cloud = agnocast::standard_msg_text("sensor_msgs/PointCloud2");
-  ASSERT_NE(cloud, nullptr);
-  EXPECT_EQ(text.rfind(std::string(*cloud), 0), 0U) << "the root's own text comes first";
-  EXPECT_NE(text.find("\nMSG: std_msgs/Header\n"), std::string::npos);
-  EXPECT_EQ(agnocast::standard_msg_text("robot/msg/Scan"), nullptr);
+  EXPECT_NE(text.find("\nMSG: sensor_msgs/PointField\n" + point_field), std::string::npos) << text;
+  const std::string cloud = msg_file("sensor_msgs", "PointCloud2");
+  ASSERT_FALSE(cloud.empty());
+  EXPECT_EQ(text.rfind(cloud, 0), 0U) << "the root's own text comes first";
+  EXPECT_NE(text.find("\nMSG: std_msgs/Header\n" + msg_file("std_msgs", "Header")),
+            std::string::npos);
+  EXPECT_EQ(schema.types[0].definition, cloud);
 }
 
 // bag play lays out a foreign file's standard types as the generated
@@ -211,17 +223,22 @@ TEST(SchemaCdr, FieldNamesOfAMsgTextSkipConstantsAndComments) {
             (std::vector<std::string>{"name", "values", "count"}));
 }
 
-// A known name whose fields differ (a user's own type of the same name)
-// gets the fields from the schema, not the standard text.
-TEST(SchemaCdr, AKnownNameWithOtherFieldsIsWrittenFromTheSchema) {
-  const agnocast::Schema schema =
+// A text whose fields are not the schema's (another process's schema lies)
+// is not written: that type's fields come from the schema.
+TEST(SchemaCdr, ATextWithOtherFieldsIsWrittenFromTheSchema) {
+  agnocast::Schema schema =
       agnocast::parse_schema(agnocast::schema_of<sensor_msgs::msg::PointCloud2>());
-  const std::string_view other = "# not the real one\nint32 only\n";
-  const std::string text =
-      agnocast::ros2msg_definition(schema, [&](std::string_view name) -> const std::string_view* {
-        return name == "sensor_msgs/msg/PointField" ? &other : nullptr;
-      });
-  EXPECT_EQ(text, agnocast::ros2msg_definition(schema));
+  const std::string truthful = agnocast::ros2msg_definition(schema);
+  for (agnocast::SchemaType& type : schema.types) {
+    if (type.name == "sensor_msgs/msg/PointField")
+      type.definition = "# not the real one\nint32 only\n";
+  }
+  const std::string text = agnocast::ros2msg_definition(schema);
+  EXPECT_EQ(text.find("int32 only"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nMSG: sensor_msgs/PointField\nstring name\nuint32 offset\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text, truthful);
 }
 
 }  // namespace

@@ -52,8 +52,11 @@
 #define AGNOCAST_TOPIC_NAME_MAX 256
 #define AGNOCAST_NODE_NAME_MAX 128
 #define AGNOCAST_TYPE_NAME_MAX 128
-/* A topic's schema: an opaque description of its type, for tools. */
-#define AGNOCAST_SCHEMA_MAX 4096
+/*
+ * A topic's schema: an opaque description of its type, for tools.  Charged
+ * to the memory cgroup of the process whose endpoint brought it.
+ */
+#define AGNOCAST_SCHEMA_MAX 65536
 
 #define AGNOCAST_DEPTH_MAX 1024
 #define AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX 1024

@@ -31,8 +31,9 @@ inline constexpr std::size_t topic_name_max = queue_name_max - subscriber_id_dig
 inline constexpr std::size_t node_name_max = 127;
 inline constexpr std::size_t type_name_max = 127;
 
-// The schema the kernel stores per topic, in bytes (AGNOCAST_SCHEMA_MAX).
-inline constexpr std::size_t schema_max_bytes = 4096;
+// The schema the kernel stores per topic, in bytes (AGNOCAST_SCHEMA_MAX): the
+// fields of every type it nests and their .msg texts.
+inline constexpr std::size_t schema_max_bytes = 65536;
 // How deep messages may nest in a schema (the message itself is level 1):
 // readers of foreign messages recurse once per level. ROS 2's standard types
 // nest at most 5 deep.

@@ -67,6 +67,10 @@ struct TypeDescriptor {
   std::uint32_t align;
   std::uint64_t hash;
   std::span<const FieldDescriptor> fields;  // empty for raw types
+  // The .msg text the type was generated from, constants and comments
+  // included; empty for a type declared in C++. Not part of the hash: two
+  // texts that differ only there share messages.
+  std::string_view definition = {};
 };
 
 // Bounds that the C++ type of a field cannot carry.
@@ -182,7 +186,7 @@ struct RawTraits<T> {
   static constexpr std::string_view type_name{RawTypeName<sizeof(T), alignof(T)>::text.data(),
                                               RawTypeName<sizeof(T), alignof(T)>::length};
   static constexpr std::uint64_t type_hash = raw_type_hash(sizeof(T), alignof(T));
-  static constexpr TypeDescriptor descriptor{type_name, sizeof(T), alignof(T), type_hash, {}};
+  static constexpr TypeDescriptor descriptor{type_name, sizeof(T), alignof(T), type_hash, {}, {}};
 };
 
 }  // namespace detail
@@ -405,9 +409,11 @@ constexpr FieldDescriptor describe_heap_field(std::string_view name, std::size_t
 
 template <class T, std::size_t N>
 constexpr TypeDescriptor describe_type(std::string_view name,
-                                       const std::array<FieldDescriptor, N>& fields) {
-  return TypeDescriptor{name, sizeof(T), alignof(T),
-                        detail::declared_type_hash(name, sizeof(T), alignof(T), fields), fields};
+                                       const std::array<FieldDescriptor, N>& fields,
+                                       std::string_view definition = {}) {
+  return TypeDescriptor{name,       sizeof(T),
+                        alignof(T), detail::declared_type_hash(name, sizeof(T), alignof(T), fields),
+                        fields,     definition};
 }
 
 }  // namespace agnocast

@@ -3,7 +3,7 @@
 // reader that does not know the type at compile time (agnocast-cli topic echo)
 // walks to decode a message in place.
 //
-// Format, version 1. All integers little-endian, records packed (no padding).
+// Format, version 2. All integers little-endian, records packed (no padding).
 //   header, 20 bytes:
 //     u32 magic "AGSC" (0x43534741)   u16 version (1)   u16 type_count (>= 1)
 //     u32 total_bytes (the blob's length)
@@ -18,6 +18,9 @@
 //            u32 offset, size, element_size, element_align, array_length,
 //                sequence_bound, string_bound
 //   A nested type's index is always greater than its user's, so a reader never loops.
+//   then for each type, in the same order: u32 definition_length, that many bytes of
+//     its .msg text as agnocast-msggen read it (constants and comments included;
+//     0 when it has none: a type declared in C++, or texts too large to fit)
 #pragma once
 
 #include <cstddef>
@@ -35,7 +38,7 @@
 namespace agnocast {
 
 inline constexpr std::uint32_t schema_magic = 0x43534741;  // "AGSC" in memory
-inline constexpr std::uint16_t schema_format_version = 1;
+inline constexpr std::uint16_t schema_format_version = 2;
 inline constexpr std::uint16_t schema_no_type = 0xFFFF;
 
 // A blob that is not a valid schema (what() says what is wrong), or a type too
@@ -65,6 +68,8 @@ struct SchemaType {
   std::uint32_t size = 0;
   std::uint32_t align = 0;
   std::vector<SchemaField> fields;
+  // Its .msg text, constants and comments included; empty when it has none.
+  std::string definition;
 };
 
 // A parsed, validated schema: types[0] is the message type.
@@ -82,8 +87,9 @@ void require_native_layout(const ContainerLayout& layout, std::string_view type_
 // Bytes of one number or bool of this kind; 0 for strings, messages and opaque bytes.
 std::uint32_t primitive_size(FieldKind kind);
 
-// The blob for a type and everything nested in it. Throws SchemaError when it
-// would exceed schema_max_bytes.
+// The blob for a type and everything nested in it, with each type's .msg
+// text; without the texts when they would not fit. Throws SchemaError when
+// even that would exceed schema_max_bytes.
 std::vector<std::uint8_t> build_schema(const TypeDescriptor& type);
 
 // Checks every bound, index, size and offset (a reader can trust the result

@@ -33,6 +33,8 @@ struct SchemaTopic {
 
   // What an endpoint of this type registers; refers to this object's strings.
   detail::MessageType message_type() const { return {type_name, type_hash, blob}; }
+  // The type's full .msg text, as rosbag2 writes it (ros2msg_definition()).
+  std::string definition() const;
 };
 
 // Throws TopicWithoutSchema, and SchemaError when the registered schema is invalid.

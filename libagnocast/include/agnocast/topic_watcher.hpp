@@ -2,7 +2,7 @@
 // follows every topic (bag record --all, agnocast-foxglove) polls, so that each
 // applies the same rules and gives a topic the same definition.
 //
-//   TopicWatcher watcher({.text_of = standard_msg_text});
+//   TopicWatcher watcher({.publishers_only = true});
 //   for (;;) {
 //     const TopicChanges changes = watcher.poll();
 //     for (const std::string& name : changes.gone) ...          // first
@@ -25,15 +25,13 @@
 #include <vector>
 
 #include "agnocast/inspect.hpp"
-#include "agnocast/schema_cdr.hpp"
 #include "agnocast/schema_topic.hpp"
 
 namespace agnocast {
 
 struct WatchedTopic {
   SchemaTopic topic;
-  // The type's ros2msg definition, as rosbag2 writes it (ros2msg_definition()
-  // with TopicWatcherOptions::text_of).
+  // The type's full .msg text, as rosbag2 writes it (SchemaTopic::definition()).
   std::string definition;
 };
 
@@ -50,8 +48,6 @@ struct TopicChanges {
 };
 
 struct TopicWatcherOptions {
-  // Each type's own .msg text where known (constants and comments included).
-  MsgTextLookup text_of;
   // Only topics this says yes to (all when unset).
   std::function<bool(const std::string& name)> wanted;
   // Endpoints the caller itself has on the topic, which do not make it present.

@@ -27,6 +27,10 @@ class BlobWriter {
     u8(static_cast<std::uint8_t>(text.size()));
     bytes_.insert(bytes_.end(), text.begin(), text.end());
   }
+  void text(std::string_view text) {
+    u32(static_cast<std::uint32_t>(text.size()));
+    bytes_.insert(bytes_.end(), text.begin(), text.end());
+  }
   std::vector<std::uint8_t>& bytes() { return bytes_; }
 
  private:
@@ -62,6 +66,15 @@ class BlobReader {
       throw SchemaError("schema: a name is empty or not printable");
     }
     return text;
+  }
+  // A .msg text: any bytes but NUL (readers hand it on as a C string).
+  std::string text() {
+    const std::size_t length = u32();
+    need(length);
+    std::string out(reinterpret_cast<const char*>(blob_.data() + position_), length);
+    position_ += length;
+    if (out.find('\0') != std::string::npos) throw SchemaError("schema: a definition holds NUL");
+    return out;
   }
   bool at_end() const { return position_ == blob_.size(); }
 
@@ -185,11 +198,10 @@ std::uint32_t primitive_size(FieldKind kind) {
   }
 }
 
-std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
-  // Reversed post-order: the message type first, every type before the types it uses.
-  std::vector<const TypeDescriptor*> sorted;
-  collect_types(root, sorted);
-  std::reverse(sorted.begin(), sorted.end());
+namespace {
+
+std::vector<std::uint8_t> schema_blob(const std::vector<const TypeDescriptor*>& sorted,
+                                      bool with_definitions) {
   std::map<const TypeDescriptor*, std::uint16_t> index;
   for (std::size_t i = 0; i < sorted.size(); ++i) index[sorted[i]] = static_cast<std::uint16_t>(i);
 
@@ -223,17 +235,35 @@ std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
       }
     }
   }
+  for (const TypeDescriptor* type : sorted) {
+    const bool usable = with_definitions && type->definition.size() <= schema_max_bytes &&
+                        type->definition.find('\0') == std::string_view::npos;
+    out.text(usable ? type->definition : std::string_view{});
+  }
   std::vector<std::uint8_t>& blob = out.bytes();
+  const auto total = static_cast<std::uint32_t>(blob.size());  // refused when too large
+  for (int i = 0; i < 4; ++i) blob[8 + i] = static_cast<std::uint8_t>(total >> (8 * i));
+  return std::move(blob);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> build_schema(const TypeDescriptor& root) {
+  // Reversed post-order: the message type first, every type before the types it uses.
+  std::vector<const TypeDescriptor*> sorted;
+  collect_types(root, sorted);
+  std::reverse(sorted.begin(), sorted.end());
+  std::vector<std::uint8_t> blob = schema_blob(sorted, true);
+  // The texts are for people and tools; a type whose texts do not fit still has a schema.
+  if (blob.size() > schema_max_bytes) blob = schema_blob(sorted, false);
   if (blob.size() > schema_max_bytes) {
     throw SchemaError("agnocast: the schema of " + std::string(root.name) + " takes " +
                       std::to_string(blob.size()) + " bytes, more than the " +
                       std::to_string(schema_max_bytes) + " a topic can hold");
   }
-  const auto total = static_cast<std::uint32_t>(blob.size());
-  for (int i = 0; i < 4; ++i) blob[8 + i] = static_cast<std::uint8_t>(total >> (8 * i));
   // What readers will refuse (nesting too deep) is refused here, at the writer.
   parse_schema(blob);
-  return std::move(blob);
+  return blob;
 }
 
 Schema parse_schema(std::span<const std::uint8_t> blob) {
@@ -293,7 +323,8 @@ Schema parse_schema(std::span<const std::uint8_t> blob) {
       field.string_bound = in.u32();
     }
   }
-  if (!in.at_end()) throw SchemaError("schema: bytes after the last type");
+  for (SchemaType& type : schema.types) type.definition = in.text();
+  if (!in.at_end()) throw SchemaError("schema: bytes after the last definition");
   for (std::size_t i = 0; i < schema.types.size(); ++i) {
     for (const SchemaField& field : schema.types[i].fields) check_field(schema, i, field);
   }

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <string>
+#include <vector>
 
 namespace schema_test {
 
@@ -134,8 +137,8 @@ constexpr std::size_t id_offset = id_kind + 4;
 TEST(Schema, RejectsCorruptBlobsSayingWhy) {
   EXPECT_EQ(error_after([](auto&) {}), "");
   EXPECT_EQ(error_after([](auto& b) { b[0] = 'X'; }), "schema: bad magic (not an agnocast schema)");
-  EXPECT_EQ(error_after([](auto& b) { b[4] = 2; }),
-            "schema: format version 2, this reader knows 1");
+  EXPECT_EQ(error_after([](auto& b) { b[4] = 1; }),
+            "schema: format version 1, this reader knows 2");
   EXPECT_EQ(error_after([](auto& b) { b.pop_back(); }),
             "schema: total_bytes differs from the blob size");
   EXPECT_EQ(error_after([](auto& b) { b[6] = 0xFF; }), "schema: truncated");
@@ -148,6 +151,53 @@ TEST(Schema, RejectsCorruptBlobsSayingWhy) {
             "schema: schema_test/msg/Track.id: field beyond the end of its type");
   EXPECT_EQ(error_after([](auto& b) { b[first_field + 1] = 0x01; }),
             "schema: a name is empty or not printable");
+  // Point's definition length, the blob's last word: past the end.
+  EXPECT_EQ(error_after([](auto& b) { b[b.size() - 4] = 5; }), "schema: truncated");
+  EXPECT_EQ(error_after([](auto& b) {
+              b.insert(b.end(), {0, 0, 0, 0});
+            }),
+            "schema: total_bytes differs from the blob size");
+}
+
+// Track as agnocast-msggen would describe it: with its .msg text.
+TypeDescriptor track_with_definition(std::string_view definition) {
+  TypeDescriptor track = message_traits<Track>::descriptor;
+  track.definition = definition;
+  return track;
+}
+
+TEST(Schema, DefinitionsTravelWithTheirTypes) {
+  const std::string text = "# a track\nuint8 KIND=1\nuint32 id\nstring label  # shown\n";
+  const std::vector<std::uint8_t> blob = build_schema(track_with_definition(text));
+  const Schema schema = parse_schema(blob);
+  ASSERT_EQ(schema.types.size(), 2u);
+  EXPECT_EQ(schema.types[0].definition, text);
+  EXPECT_EQ(schema.types[1].definition, "");  // Point, declared in C++
+  // The text is not the layout: the hash stays the type's.
+  EXPECT_EQ(schema.types[0].hash, message_traits<Track>::type_hash);
+}
+
+TEST(Schema, DefinitionsThatCannotTravelAreLeftOut) {
+  // Too large for the kernel's bound: the fields still make a schema.
+  const std::string huge(schema_max_bytes, '#');
+  const Schema without = parse_schema(build_schema(track_with_definition(huge)));
+  EXPECT_EQ(without.types[0].definition, "");
+  EXPECT_EQ(without.types[0].fields.size(), 6u);
+  // A NUL would cut the text short for whoever reads it as a C string.
+  const std::string with_nul("uint32 id\0string label\n", 24);
+  EXPECT_EQ(parse_schema(build_schema(track_with_definition(with_nul))).types[0].definition, "");
+  // ... and a blob that carries one anyway is refused.
+  std::vector<std::uint8_t> blob = build_schema(track_with_definition("a#b\n"));
+  const std::string text = "a#b\n";
+  const auto at = std::search(blob.begin(), blob.end(), text.begin(), text.end());
+  ASSERT_NE(at, blob.end());
+  *(at + 1) = 0;
+  try {
+    parse_schema(blob);
+    ADD_FAILURE() << "a definition holding NUL was accepted";
+  } catch (const SchemaError& error) {
+    EXPECT_STREQ(error.what(), "schema: a definition holds NUL");
+  }
 }
 
 TEST(Schema, NestedIndexMustPointForward) {

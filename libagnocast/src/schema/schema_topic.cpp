@@ -3,8 +3,11 @@
 #include <utility>
 
 #include "agnocast/inspect.hpp"
+#include "agnocast/schema_definition.hpp"
 
 namespace agnocast {
+
+std::string SchemaTopic::definition() const { return ros2msg_definition(schema); }
 
 std::optional<SchemaTopic> find_schema_topic(std::string_view topic) {
   const std::string name(topic);

@@ -27,7 +27,7 @@ TopicChanges TopicWatcher::poll() {
     try {
       std::optional<SchemaTopic> found = options_.resolve(topic.name);
       if (!found || found->type_hash != topic.type_hash) continue;  // changed meanwhile
-      std::string definition = ros2msg_definition(found->schema, options_.text_of);
+      std::string definition = found->definition();
       changes.appeared.push_back({std::move(*found), std::move(definition)});
       now.emplace(topic.name, type);
     } catch (const std::exception& error) {

@@ -115,17 +115,15 @@ TEST(TopicWatcher, UsesTheTypesOwnTextAndRefusesWhatHasNoDefinitionOnce) {
   Topics topics;
   topics.add<Reading>("/a", 1, 0);
   TopicWatcherOptions options = topics.options();
+  // As agnocast-msggen's schema carries it (a type declared in C++ has none).
   const std::string text = "# a comment\nfloat64 value\nuint8 MODE_FAST=1\n";
-  const std::string_view view = text;
-  options.text_of = [&](std::string_view type) -> const std::string_view* {
-    return type == "topic_watcher_test/msg/Reading" ? &view : nullptr;
-  };
   int resolved = 0;
   const auto resolve = options.resolve;
   options.resolve = [&](const std::string& name) {
     ++resolved;
     std::optional<SchemaTopic> topic = resolve(name);
     if (name == "/broken") throw SchemaError("schema: bad magic");
+    if (topic) topic->schema.types[0].definition = text;
     return topic;
   };
   TopicWatcher watcher(options);

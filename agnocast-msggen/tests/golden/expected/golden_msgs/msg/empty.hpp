@@ -20,8 +20,10 @@ struct agnocast::message_traits<golden_msgs::msg::Empty> {
   static constexpr std::array fields{
       agnocast::describe_field<decltype(Message::structure_needs_at_least_one_member)>("structure_needs_at_least_one_member", offsetof(Message, structure_needs_at_least_one_member)),
   };
+  static constexpr std::string_view definition =
+      "# Nothing but a signal.\n";
   static constexpr agnocast::TypeDescriptor descriptor =
-      agnocast::describe_type<Message>(type_name, fields);
+      agnocast::describe_type<Message>(type_name, fields, definition);
   static constexpr std::uint64_t type_hash = descriptor.hash;
 };
 

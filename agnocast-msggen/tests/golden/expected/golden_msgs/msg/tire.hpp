@@ -21,8 +21,11 @@ struct agnocast::message_traits<golden_msgs::msg::Tire> {
       agnocast::describe_field<decltype(Message::pressure_kpa)>("pressure_kpa", offsetof(Message, pressure_kpa)),
       agnocast::describe_field<decltype(Message::brand)>("brand", offsetof(Message, brand)),
   };
+  static constexpr std::string_view definition =
+      "uint16 pressure_kpa 220\n"
+      "string brand\n";
   static constexpr agnocast::TypeDescriptor descriptor =
-      agnocast::describe_type<Message>(type_name, fields);
+      agnocast::describe_type<Message>(type_name, fields, definition);
   static constexpr std::uint64_t type_hash = descriptor.hash;
 };
 

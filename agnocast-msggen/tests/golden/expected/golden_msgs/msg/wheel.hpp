@@ -59,8 +59,32 @@ struct agnocast::message_traits<golden_msgs::msg::Wheel> {
       agnocast::describe_field<decltype(Message::code)>("code", offsetof(Message, code)),
       agnocast::describe_field<decltype(Message::odometer)>("odometer", offsetof(Message, odometer)),
   };
+  static constexpr std::string_view definition =
+      "# One wheel of a robot, as its drive reports it.\n"
+      "\n"
+      "# Drive modes\n"
+      "uint8 MODE_IDLE=0\n"
+      "uint8 MODE_DRIVE=1  # moving\n"
+      "string LABEL=front # left\n"
+      "int64 MIN_TICKS=-9223372036854775808\n"
+      "float32 MAX_SPEED=2.5\n"
+      "\n"
+      "std_msgs/Header header\n"
+      "Tire tire                      # a type of the same package\n"
+      "string<=16 name \"wheel\"\n"
+      "float64 radius 0.3\n"
+      "int32[3] ticks [1, -2, 3]\n"
+      "float32[] speeds\n"
+      "string<=8[<=4] tags ['a', \"b,c\"]\n"
+      "bool[] flags\n"
+      "bool enabled true\n"
+      "Tire[2] spares\n"
+      "geometry_msgs/Vector3[<=3] axes\n"
+      "byte status\n"
+      "char code 65\n"
+      "uint64 odometer 18446744073709551615\n";
   static constexpr agnocast::TypeDescriptor descriptor =
-      agnocast::describe_type<Message>(type_name, fields);
+      agnocast::describe_type<Message>(type_name, fields, definition);
   static constexpr std::uint64_t type_hash = descriptor.hash;
 };
 

@@ -56,12 +56,12 @@ struct ServiceOptions {
 struct ServiceHooks {
   // The daemon's own fields, written after the head (a field the head has
   // keeps the head's value). Called on the loop's thread; none: the head alone.
-  std::function<nlohmann::json(const agnocast::ServiceStatus& head)> status_body;
+  std::function<nlohmann::json(const agnocast::ServiceStatus& head)> status_body = {};
   // SIGHUP: re-read the configuration. None: SIGHUP stops the daemon as SIGTERM does.
-  std::function<void()> reload;
+  std::function<void()> reload = {};
   // Asked before each watchdog ping; false withholds the ping (systemd then
   // restarts the daemon), so the hook logs why. None: always healthy.
-  std::function<bool()> healthy;
+  std::function<bool()> healthy = {};
 };
 
 class ServiceLoop {

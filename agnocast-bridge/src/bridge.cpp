@@ -1,6 +1,5 @@
 #include "bridge.hpp"
 
-#include <signal.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -8,8 +7,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstring>
-#include <ctime>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -19,13 +16,11 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/executor.hpp"
 #include "agnocast/inspect.hpp"
+#include "agnocast/status.hpp"
 #include "agnocast/version.hpp"
-#include "agnocast_service/instance_lock.hpp"
 #include "agnocast_service/journal_log.hpp"
 #include "agnocast_service/notify.hpp"
-#include "agnocast_service/signals.hpp"
-#include "agnocast_service/timer.hpp"
-#include "agnocast_service/watchdog.hpp"
+#include "agnocast_service/service_loop.hpp"
 #include "config.hpp"
 #include "dds_domain.hpp"
 #include "status_file.hpp"
@@ -37,9 +32,6 @@ constexpr const char* node_name = "agnocast_bridge";
 constexpr int exit_failure = 1;
 constexpr int exit_usage = 2;  // a bad command line or configuration
 
-// The signals that stop the bridge; any other keeps its default action.
-sigset_t stop_signals() { return agnocast_service::signal_set({SIGTERM, SIGINT}); }
-constexpr auto status_interval = std::chrono::seconds(1);
 // How long the DDS receiver waits before it turns its loop again when no
 // sample comes: it proves it is alive at least this often.
 constexpr auto receiver_turn = std::chrono::seconds(1);
@@ -146,14 +138,9 @@ std::uint64_t lost_on_agnocast_side(const TopicConfig& topic, std::uint32_t subs
   return 0;
 }
 
-BridgeStatus collect_status(const Config& config, const std::vector<BridgedTopic>& topics,
-                            std::int64_t started_at, bool running) {
+BridgeStatus collect_status(const Config& config, const std::vector<BridgedTopic>& topics) {
   BridgeStatus status;
-  status.running = running;
-  status.pid = ::getpid();
   status.domain_id = config.domain_id;
-  status.started_at = started_at;
-  status.uptime_s = static_cast<std::int64_t>(std::time(nullptr)) - started_at;
   for (const auto& topic : topics) {
     TopicStatus entry{topic.config, topic.counters->relayed, topic.counters->dropped,
                       topic.counters->errors};
@@ -165,22 +152,12 @@ BridgeStatus collect_status(const Config& config, const std::vector<BridgedTopic
   return status;
 }
 
-void write_status(const Config& config, const std::vector<BridgedTopic>& topics,
-                  std::int64_t started_at, bool running) {
-  try {
-    write_status_file(std::string(status_path),
-                      collect_status(config, topics, started_at, running));
-  } catch (const std::exception& error) {
-    spdlog::error("status file: {}", error.what());
-  }
-}
-
 int serve(const Config& config, const TypeRegistry& types) {
   DdsDomain domain(config.domain_id);
   // One bridge per machine: its loop protection recognizes only its own
   // process's publications, and two bridges would relay each other's.
-  const agnocast_service::InstanceLock lock{std::string(lock_path), "agnocast-bridge"};
-  const auto started_at = static_cast<std::int64_t>(std::time(nullptr));
+  agnocast_service::ServiceLoop service(
+      {.program = "agnocast-bridge", .status_path = std::string(agnocast::bridge_status_path)});
 
   agnocast::Node node(node_name);
   std::vector<BridgedTopic> topics;
@@ -200,43 +177,35 @@ int serve(const Config& config, const TypeRegistry& types) {
     }
   }
 
-  // One loop: agnocast's subscriptions, the stop signals, the status file's
-  // timer and the watchdog's; DDS samples come on the receiver's thread.
+  // One loop: agnocast's subscriptions and the service's descriptor (signals,
+  // the status file's timer, the watchdog's); DDS samples come on the
+  // receiver's thread.
   agnocast::SingleThreadedExecutor executor;
   executor.add_node(node);
   const DdsReceiver receiver(domain, topics);
-  agnocast_service::SignalFd signals(stop_signals());
-  executor.add_fd(signals.fd(), [&signals, &executor] {
-    while (const auto signal = signals.read()) {
-      spdlog::info("received {}, stopping", strsignal(*signal));
-      executor.cancel();
-    }
-  });
-  agnocast_service::PeriodicTimer status_timer(status_interval);
-  executor.add_fd(status_timer.fd(), [&] {
-    status_timer.consume();
-    write_status(config, topics, started_at, true);
+  executor.add_fd(service.fd(), [&service, &executor] {
+    if (!service.dispatch()) executor.cancel();
   });
   // Pinged from this loop, and only while the receiver's loop turns too.
-  agnocast_service::Watchdog watchdog;
   const auto receiver_limit = std::max<std::chrono::steady_clock::duration>(
-      watchdog.interval().value_or(std::chrono::microseconds{0}), 2 * receiver_turn);
-  executor.add_fd(watchdog.fd(), [&] {
+      agnocast_service::watchdog_ping_interval().value_or(std::chrono::microseconds{0}),
+      2 * receiver_turn);
+  agnocast_service::ServiceHooks hooks;
+  hooks.status_body = [&config, &topics](const agnocast::ServiceStatus&) {
+    return status_body(collect_status(config, topics));
+  };
+  hooks.healthy = [&receiver, receiver_limit] {
     const bool alive = receiver.alive(receiver_limit);
-    watchdog.tick(alive);
     if (!alive) spdlog::error("the DDS receiver is stuck; not pinging the watchdog");
-  });
-
-  write_status(config, topics, started_at, true);
+    return alive;
+  };
   spdlog::info("relaying {} topic(s) on DDS domain {}", topics.size(), config.domain_id);
-  agnocast_service::notify("READY=1\nSTATUS=relaying " + std::to_string(topics.size()) +
-                           " topic(s) on DDS domain " + std::to_string(config.domain_id));
+  service.ready("relaying " + std::to_string(topics.size()) + " topic(s) on DDS domain " +
+                    std::to_string(config.domain_id),
+                std::move(hooks));
   executor.spin();
-  agnocast_service::notify("STOPPING=1");
-  executor.remove_fd(watchdog.fd());
-  executor.remove_fd(status_timer.fd());
-  executor.remove_fd(signals.fd());
-  write_status(config, topics, started_at, false);
+  executor.remove_fd(service.fd());
+  service.stopped();
   return 0;
 }
 
@@ -280,9 +249,9 @@ int run_bridge(int argc, char** argv, const TypeRegistry& types) {
     return EXIT_SUCCESS;
   }
   try {
-    // Stop signals queue for the serve loop from here on, before any thread
-    // (Cyclone DDS's) starts: every thread inherits the mask.
-    agnocast_service::block_signals(stop_signals());
+    // The service's signals queue for its loop from here on, before any
+    // thread (Cyclone DDS's) starts: every thread inherits the mask.
+    agnocast_service::block_signals(agnocast_service::service_signals());
     return serve(config, types);
   } catch (const ConfigError& error) {
     spdlog::error("bad configuration {}: {}", config_path, error.what());

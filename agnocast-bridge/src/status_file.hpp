@@ -1,23 +1,21 @@
-// The bridge's status file, one JSON object replaced atomically, 0644:
-//   {"running":true,"pid":42,"domain_id":0,"started_at":1700000000,"uptime_s":12,
+// The bridge's fields of its status file (agnocast::bridge_status_path),
+// written after the head every daemon writes (<agnocast/status.hpp>):
+//   {"program":"agnocast-bridge","pid":42,...,"running":true,...,
+//    "domain_id":0,
 //    "topics":[{"name":"/points","type":"sensor_msgs/msg/PointCloud2",
 //               "direction":"to_dds","dds_topic":"rt/points",
 //               "dds_type":"sensor_msgs::msg::dds_::PointCloud2_",
 //               "relayed":120,"dropped":0,"errors":0}]}
-// Written at start, every second and with "running":false on a clean stop.
+// Written at start, every second, at stop and with "state":"stopped" last.
 #pragma once
 
 #include <cstdint>
-#include <string>
-#include <string_view>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "config.hpp"
 
 namespace agnocast_bridge {
-
-inline constexpr std::string_view status_path = "/run/agnocast/bridge.json";
-inline constexpr std::string_view lock_path = "/run/agnocast/bridge.lock";
 
 struct TopicStatus {
   const TopicConfig* topic = nullptr;
@@ -27,17 +25,11 @@ struct TopicStatus {
 };
 
 struct BridgeStatus {
-  bool running = true;
-  int pid = 0;
   std::uint32_t domain_id = 0;
-  std::int64_t started_at = 0;  // Unix seconds
-  std::int64_t uptime_s = 0;
   std::vector<TopicStatus> topics;
 };
 
-std::string status_json(const BridgeStatus& status);
-// Replaces path (agnocast_service::write_file_atomically); throws
-// std::system_error when the file cannot be written.
-void write_status_file(const std::string& path, const BridgeStatus& status);
+// {"domain_id":..,"topics":[..]}
+nlohmann::json status_body(const BridgeStatus& status);
 
 }  // namespace agnocast_bridge

@@ -7,18 +7,23 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "agnocast_service/status_file.hpp"
+
 namespace agnocast_bridge {
 namespace {
 
 TEST(StatusFile, CountersPerTopicAsJson) {
   TopicConfig points{"/points", "sensor_msgs/msg/PointCloud2", Direction::to_dds, {}};
   TopicConfig cmd{"/cmd_vel", "geometry_msgs/msg/Twist", Direction::from_dds, {}};
-  BridgeStatus status{true, 42, 7, 1700000000, 5, {{&points, 10, 1, 2}, {&cmd, 3, 0, 0}}};
+  BridgeStatus status{7, {{&points, 10, 1, 2}, {&cmd, 3, 0, 0}}};
+  const agnocast::ServiceStatus head{
+      "agnocast-bridge", 42, "0.1.0", agnocast::ServiceState::running, 1700000000, 5, 1700000005};
 
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("bridge-status-" + std::to_string(::getpid()));
   const std::string path = (dir / "bridge.json").string();
-  write_status_file(path, status);
+  // As the service loop writes it: the head, then the bridge's fields.
+  agnocast_service::write_status_file(path, head, status_body(status));
   std::ifstream file(path);
   const auto json = nlohmann::json::parse(file);
   EXPECT_EQ(std::filesystem::status(path).permissions() & std::filesystem::perms::all,

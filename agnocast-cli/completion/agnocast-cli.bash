@@ -13,7 +13,7 @@ _agnocast_cli() {
     [[ $word == -* ]] || words+=("$word")
   done
   case $prev in
-    --window | --count | --timeout | --status-file | --max-size | --duration | --rate | --start-offset) return ;;
+    --window | --count | --timeout | --status-file | --bridge-status-file | --foxglove-status-file | --max-size | --duration | --rate | --start-offset) return ;;
     --compression) COMPREPLY=($(compgen -W "zstd lz4 none" -- "$cur")); return ;;
     -o | --output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
   esac
@@ -64,7 +64,8 @@ _agnocast_cli() {
         candidates=$(_agnocast_cli_names node)
       fi
       ;;
-    "daemon status" | "doctor ") candidates="--status-file --json --help" ;;
+    "daemon status") candidates="--status-file --bridge-status-file --foxglove-status-file --json --help" ;;
+    "doctor ") candidates="--status-file --json --help" ;;
     *) candidates="--json --help" ;;
   esac
   COMPREPLY=($(compgen -W "$candidates" -- "$cur"))

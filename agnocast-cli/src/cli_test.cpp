@@ -5,6 +5,7 @@
 
 #include <sstream>
 
+#include "agnocast/status.hpp"
 #include "fake_source.hpp"
 
 namespace agnocast::cli {
@@ -180,6 +181,24 @@ TEST(Cli, DaemonStatusFileOption) {
   source.files.erase("/run/agnocast/agnocastd.json");
   const Outcome r = run(source, {"daemon", "status", "--status-file", "/tmp/d.json", "--json"});
   EXPECT_TRUE(nlohmann::json::parse(r.out)["running"].get<bool>());
+}
+
+TEST(Cli, DaemonStatusShowsTheBridgeAndFoxgloveFromTheirFiles) {
+  FakeSource source = healthy_system();
+  source.files["/tmp/b.json"] = to_json(
+      ServiceStatus{"agnocast-bridge", 60, "0.1.0", ServiceState::running, 1700000000, 1, 1});
+  source.locks["/tmp/b.lock"] = true;
+  const Outcome r = run(source, {"daemon", "status", "--bridge-status-file", "/tmp/b.json",
+                                 "--foxglove-status-file", "/tmp/none.json", "--json"});
+  EXPECT_EQ(r.code, 0);
+  const auto value = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(value["running"].get<bool>());
+  EXPECT_EQ(value["bridge"]["pid"], 60);
+  EXPECT_FALSE(value["foxglove"]["running"].get<bool>());
+  const Outcome table = run(source, {"daemon", "status", "--bridge-status-file", "/tmp/b.json"});
+  EXPECT_NE(table.out.find("agnocast-bridge    yes"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("agnocast-foxglove  no"), std::string::npos) << table.out;
+  EXPECT_EQ(table.err, "");  // only a stopped agnocastd is worth a hint
 }
 
 }  // namespace

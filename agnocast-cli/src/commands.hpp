@@ -84,6 +84,21 @@ struct DaemonStatusRead {
 DaemonStatusRead read_daemon_status(InspectionSource& source, const std::string& status_path);
 // `status_path` is agnocastd's status file; its lock file sits beside it.
 nlohmann::json daemon_status_json(InspectionSource& source, const std::string& status_path);
+// Another daemon's status file (agnocast-bridge's, agnocast-foxglove's): the
+// file's object with uptime_s as of now while `program` runs (its lock beside
+// the file held, see <agnocast/status.hpp>), else
+// {"running":false,"pid":null,"uptime_s":null}.
+nlohmann::json service_status_json(InspectionSource& source, const std::string& status_path,
+                                   const std::string& program);
+struct DaemonStatusPaths {
+  std::string agnocastd{daemon_status_path};
+  std::string bridge{bridge_status_path};
+  std::string foxglove{foxglove_status_path};
+};
+// What `daemon status` prints: daemon_status_json() with "bridge" and
+// "foxglove" added, each a service_status_json().
+nlohmann::json daemon_status_command_json(InspectionSource& source, const DaemonStatusPaths& paths);
+// agnocastd's lines, then a row per other daemon the value has.
 std::string daemon_status_table(const nlohmann::json& value);
 
 void set_doctor_command(CLI::App& app, Context& context);

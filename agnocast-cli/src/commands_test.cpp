@@ -274,6 +274,101 @@ TEST(DaemonStatus, MissingOrGarbledFileMeansNotRunning) {
   EXPECT_FALSE(daemon_status_json(source, "/typo.json")["running"].get<bool>());
 }
 
+// A status file as the service kit writes it: the head, then the daemon's fields.
+std::string service_file(const std::string& program, pid_t pid, const std::string& fields,
+                         ServiceState state = ServiceState::running) {
+  std::string text =
+      to_json(ServiceStatus{program, pid, "0.1.0", state, 1700000000, 12, 1700000012});
+  text.replace(text.rfind('}'), 1, "," + fields + "}");
+  return text;
+}
+
+// healthy_system() with agnocast-bridge running as pid 60.
+FakeSource system_with_bridge() {
+  FakeSource source = healthy_system();
+  source.files["/run/agnocast/bridge.json"] = service_file(
+      "agnocast-bridge", 60,
+      R"("domain_id":0,"topics":[{"name":"/points","relayed":120,"dropped":0,"errors":0}])");
+  source.locks["/run/agnocast/bridge.lock"] = true;
+  source.alive.insert(60);
+  return source;
+}
+
+TEST(DaemonStatus, TheOtherDaemonsBesideAgnocastdsUnchangedFields) {
+  FakeSource source = system_with_bridge();
+  const json value = daemon_status_command_json(source, {});
+  json agnocastd = value;
+  agnocastd.erase("bridge");
+  agnocastd.erase("foxglove");
+  EXPECT_EQ(agnocastd, daemon_status_json(source, "/run/agnocast/agnocastd.json"));
+
+  const json& bridge = value["bridge"];
+  EXPECT_EQ(bridge["running"], true);
+  EXPECT_EQ(bridge["pid"], 60);
+  EXPECT_EQ(bridge["program"], "agnocast-bridge");
+  EXPECT_EQ(bridge["state"], "running");
+  EXPECT_EQ(bridge["version"], "0.1.0");
+  EXPECT_EQ(bridge["uptime_s"], 100);  // as of now, from started_at
+  EXPECT_EQ(bridge["topics"][0]["relayed"], 120);
+  EXPECT_EQ(value["foxglove"], json::parse(R"({"running":false,"pid":null,"uptime_s":null})"));
+}
+
+TEST(DaemonStatus, AnotherDaemonRunsOnlyWhileItHoldsItsLock) {
+  FakeSource source = system_with_bridge();
+  source.locks["/run/agnocast/bridge.lock"] = false;  // crashed
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            false);
+  // Without a lock file to open, a live pid of that program.
+  source.locks.erase("/run/agnocast/bridge.lock");
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            true);
+  source.files["/proc/60/comm"] = "bash\n";
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            false);
+  source.files.erase("/proc/60/comm");
+  source.alive.erase(60);
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            false);
+}
+
+TEST(DaemonStatus, ProcCutsTheProgramNameTo15Characters) {
+  FakeSource source = healthy_system();
+  source.files["/run/agnocast/foxglove.json"] =
+      service_file("agnocast-foxglove", 70, R"("port":8765)");
+  source.alive.insert(70);
+  source.files["/proc/70/comm"] = "agnocast-foxglo\n";
+  const json foxglove =
+      service_status_json(source, "/run/agnocast/foxglove.json", "agnocast-foxglove");
+  EXPECT_EQ(foxglove["running"], true);
+  EXPECT_EQ(foxglove["port"], 8765);
+}
+
+TEST(DaemonStatus, AStoppedOrGarbledFileOfAnotherDaemonMeansNotRunning) {
+  FakeSource source = system_with_bridge();
+  source.files["/run/agnocast/bridge.json"] =
+      service_file("agnocast-bridge", 60, R"("topics":[])", ServiceState::stopped);
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            false);
+  source.files["/run/agnocast/bridge.json"] = R"({"running":true,"pid":60})";  // no head
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            false);
+  source.files["/run/agnocast/bridge.json"] = "{not json";
+  EXPECT_EQ(service_status_json(source, "/run/agnocast/bridge.json", "agnocast-bridge")["running"],
+            false);
+}
+
+TEST(DaemonStatus, TheTableEndsWithARowPerOtherDaemon) {
+  FakeSource source = system_with_bridge();
+  const std::string table = daemon_status_table(daemon_status_command_json(source, {}));
+  EXPECT_EQ(table.rfind("running            yes\npid                50\n", 0), 0u);
+  EXPECT_NE(table.find("shm_removed        0\n\n"
+                       "DAEMON             RUNNING  STATE    PID  UPTIME_S  VERSION\n"
+                       "agnocast-bridge    yes      running   60       100  0.1.0\n"
+                       "agnocast-foxglove  no       -          -         -  -\n"),
+            std::string::npos)
+      << table;
+}
+
 const json& check_named(const json& doctor, const std::string& name) {
   for (const json& c : doctor["checks"]) {
     if (c["name"] == name) return c;

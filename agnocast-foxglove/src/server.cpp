@@ -1,16 +1,17 @@
 #include "server.hpp"
 
 #include <poll.h>
+#include <spdlog/spdlog.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <deque>
-#include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
 #include <utility>
@@ -25,10 +26,9 @@
 #include "agnocast/schema_publisher.hpp"
 #include "agnocast/schema_subscription.hpp"
 #include "agnocast/schema_topic.hpp"
-#include "agnocast/signals.hpp"
 #include "agnocast/topic_watcher.hpp"
-#include "agnocast_service/notify.hpp"
-#include "agnocast_service/watchdog.hpp"
+#include "agnocast_service/service_loop.hpp"
+#include "agnocast_service/timer.hpp"
 #include "protocol.hpp"
 
 namespace agnocast::foxglove {
@@ -48,14 +48,7 @@ constexpr std::size_t pending_publish_bytes = 32 << 20;
 // and reads nothing gets no more.
 constexpr std::size_t outbox_statuses = 256;
 constexpr auto discovery_interval = std::chrono::seconds(1);
-constexpr int poll_interval_ms = 100;
 constexpr int time_every_ticks = 2;  // a time frame every 100 ms
-
-std::mutex log_mutex;
-void log(const std::string& line) {
-  const std::lock_guard lock(log_mutex);
-  std::cerr << "agnocast-foxglove: " << line << std::endl;
-}
 
 std::uint64_t realtime_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -128,8 +121,9 @@ struct KnownChannel {
 
 class Server final : public WebSocketHandler {
  public:
-  explicit Server(const ServerOptions& options)
+  Server(const ServerOptions& options, agnocast_service::ServiceLoop& service)
       : options_(options),
+        service_(service),
         wake_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
         node_("agnocast_foxglove"),
         websocket_(options.websocket, *this) {
@@ -143,19 +137,28 @@ class Server final : public WebSocketHandler {
     const std::string host = address.find(':') == std::string::npos ? address : "[" + address + "]";
     const std::string serving = "serving " + std::string(subprotocol) + " on ws://" + host + ":" +
                                 std::to_string(websocket_.port());
-    log(serving);
+    spdlog::info("{}", serving);
+    agnocast_service::PeriodicTimer discovery_timer(discovery_interval);
+    service_.add_fd(discovery_timer.fd(), "the discovery timer", [this, &discovery_timer] {
+      discovery_timer.consume();
+      discover();
+    });
     std::thread websocket_thread([this] {
       websocket_.run();
       websocket_running_ = false;
     });
-    agnocast_service::notify("READY=1\nSTATUS=" + serving);
+    agnocast_service::ServiceHooks hooks;
+    hooks.status_body = [this](const agnocast::ServiceStatus&) { return status_body(); };
+    // The watchdog is pinged from this loop, and only while the WebSocket
+    // thread's loop runs too.
+    hooks.healthy = [this] {
+      if (!websocket_running_)
+        spdlog::error("the WebSocket thread stopped; not pinging the watchdog");
+      return websocket_running_.load();
+    };
     try {
-      auto next_discovery = std::chrono::steady_clock::now() + discovery_interval;
-      while (agnocast::ok()) {
-        if (std::chrono::steady_clock::now() >= next_discovery) {
-          discover();
-          next_discovery = std::chrono::steady_clock::now() + discovery_interval;
-        }
+      service_.ready(serving, std::move(hooks));
+      while (!service_.stopping()) {
         handle_commands();
         wait_and_receive();
       }
@@ -164,11 +167,11 @@ class Server final : public WebSocketHandler {
       websocket_thread.join();
       throw;
     }
-    log("stopping");
-    agnocast_service::notify("STOPPING=1");
     websocket_.stop();
     websocket_thread.join();
+    service_.remove_fd(discovery_timer.fd());
     clients_.clear();
+    service_.stopped();
     return 0;
   }
 
@@ -177,19 +180,19 @@ class Server final : public WebSocketHandler {
   void opened(ClientId client, const std::string& remote) override {
     auto outbox = std::make_shared<Outbox>();
     outboxes_[client] = outbox;
-    log("client " + std::to_string(client) + " connected from " + remote);
+    spdlog::info("client {} connected from {}", client, remote);
     push(Open{client, std::move(outbox)});
   }
 
   void closed(ClientId client) override {
     outboxes_.erase(client);
-    log("client " + std::to_string(client) + " disconnected");
+    spdlog::info("client {} disconnected", client);
     push(Close{client});
   }
 
   void refused(const std::string& remote) override {
-    log("refused a client from " + remote + ": " + std::to_string(options_.websocket.max_clients) +
-        " are connected (--max-clients)");
+    spdlog::warn("refused a client from {}: {} are connected (--max-clients)", remote,
+                 options_.websocket.max_clients);
   }
 
   void text(ClientId client, const std::string& payload) override {
@@ -467,7 +470,7 @@ class Server final : public WebSocketHandler {
             serialize_with_schema(message.data(), raw->kernel->schema(), raw->cdr,
                                   {.readable = message.readable()});
           } catch (const std::exception& error) {
-            log("a message on " + raw->kernel->topic() + " has no CDR form: " + error.what());
+            spdlog::warn("a message on {} has no CDR form: {}", raw->kernel->topic(), error.what());
             return;
           }
           std::string frame = message_data_frame(sub_id, stamp, raw->cdr);
@@ -487,9 +490,8 @@ class Server final : public WebSocketHandler {
   void forget_endpoint(const Subscription& subscription) { --ours_[subscription.kernel->topic()]; }
 
   void wait_and_receive() {
-    // The watchdog is pinged from this loop, and only while the WebSocket
-    // thread's loop runs too.
-    std::vector<pollfd> fds{{wake_fd_, POLLIN, 0}, {watchdog_.fd(), POLLIN, 0}};
+    // The service's descriptor: signals, the watchdog, the status and discovery timers.
+    std::vector<pollfd> fds{{wake_fd_, POLLIN, 0}, {service_.fd(), POLLIN, 0}};
     constexpr std::size_t first_subscription = 2;
     std::vector<Subscription*> polled;
     for (auto& [id, client] : clients_) {
@@ -500,10 +502,10 @@ class Server final : public WebSocketHandler {
       }
       if (full != client.behind) {
         client.behind = full;
-        log("client " + std::to_string(id) +
-            (full ? " does not keep up: the kernel drops its oldest messages "
-                    "(agnocast-cli topic info, node agnocast_foxglove)"
-                  : " keeps up again"));
+        spdlog::info("client {}{}", id,
+                     full ? " does not keep up: the kernel drops its oldest messages "
+                            "(agnocast-cli topic info, node agnocast_foxglove)"
+                          : " keeps up again");
       }
       if (full) continue;  // its messages wait in the kernel, which drops beyond the depth
       for (auto& [sub_id, subscription] : client.subscriptions) {
@@ -511,19 +513,26 @@ class Server final : public WebSocketHandler {
         polled.push_back(subscription.get());
       }
     }
-    if (::poll(fds.data(), fds.size(), poll_interval_ms) <= 0) return;
+    if (::poll(fds.data(), fds.size(), -1) <= 0) return;
     if (fds[0].revents != 0) {
       std::uint64_t count = 0;
       [[maybe_unused]] const ssize_t read = ::read(wake_fd_, &count, sizeof count);
     }
-    if (fds[1].revents != 0) {
-      const bool healthy = websocket_running_;
-      watchdog_.tick(healthy);
-      if (!healthy) log("the WebSocket thread stopped; not pinging the watchdog");
-    }
+    if (fds[1].revents != 0 && !service_.dispatch()) return;
     for (std::size_t i = first_subscription; i < fds.size(); ++i) {
       if (fds[i].revents != 0) polled[i - first_subscription]->kernel->receive();
     }
+  }
+
+  // The server's fields of its status file, after the head.
+  nlohmann::json status_body() const {
+    std::size_t subscriptions = 0;
+    for (const auto& [id, client] : clients_) subscriptions += client.subscriptions.size();
+    return {{"address", options_.websocket.address},
+            {"port", websocket_.port()},
+            {"clients", clients_.size()},
+            {"channels", channels_.size()},
+            {"subscriptions", subscriptions}};
   }
 
   // Which topics are channels: a typed topic while an endpoint that is not this
@@ -575,17 +584,18 @@ class Server final : public WebSocketHandler {
       channels_.insert_or_assign(topic.topic, std::move(channel));
     }
     for (const RefusedTopic& topic : changes.refused) {
-      log("not serving " + topic.name + " (" + topic.type_name + "): " + topic.problem);
+      spdlog::warn("not serving {} ({}): {}", topic.name, topic.type_name, topic.problem);
     }
     for (auto& [client_id, client] : clients_) {
       if (!removed.empty()) send(client_id, client, unadvertise_json(removed));
       if (!added.empty()) send(client_id, client, advertise_json(added));
     }
     for (const Channel& channel : added)
-      log("advertising " + channel.topic + " (" + channel.schema_name + ")");
+      spdlog::info("advertising {} ({})", channel.topic, channel.schema_name);
   }
 
   const ServerOptions& options_;
+  agnocast_service::ServiceLoop& service_;
   const int wake_fd_;
   const std::string session_id_ = std::to_string(realtime_ns());
   Node node_;
@@ -609,14 +619,18 @@ class Server final : public WebSocketHandler {
   std::vector<Command> commands_;
   std::atomic<std::size_t> publish_bytes_waiting_ = 0;
   std::atomic<bool> websocket_running_ = true;
-  agnocast_service::Watchdog watchdog_;
 };
 
 }  // namespace
 
 int serve(const ServerOptions& options) {
-  install_signal_handlers();
-  Server server(options);
+  // One server per status file; the signals queue for the service's
+  // descriptor from here on, in every thread started later. A user without
+  // access to /run/agnocast runs it without the status file.
+  agnocast_service::ServiceLoop service({.program = "agnocast-foxglove",
+                                         .status_path = options.status_path,
+                                         .status_optional = true});
+  Server server(options, service);
   return server.run();
 }
 

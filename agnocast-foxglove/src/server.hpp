@@ -28,10 +28,14 @@ namespace agnocast::foxglove {
 struct ServerOptions {
   WebSocketOptions websocket;
   std::optional<std::regex> topics;  // only topics whose whole name matches
+  // Its status file (agnocast-cli daemon status), its lock beside it: one
+  // server per status file.
+  std::string status_path;
 };
 
-// Serves until SIGINT/SIGTERM. Throws std::runtime_error when it cannot listen,
-// agnocast::Error when the module is not there.
+// Serves until SIGINT/SIGTERM/SIGHUP. Throws agnocast_service::AlreadyRunning
+// when another server writes the status file, std::runtime_error when it
+// cannot listen, agnocast::Error when the module is not there.
 int serve(const ServerOptions& options);
 
 }  // namespace agnocast::foxglove

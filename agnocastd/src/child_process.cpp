@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "agnocast_service/errno_error.hpp"
+#include "agnocast_service/service_loop.hpp"
 #include "daemon_signals.hpp"
 
 extern char** environ;
@@ -28,7 +29,7 @@ class SpawnSetup {
     ::posix_spawn_file_actions_init(&actions_);
     sigset_t none;
     sigemptyset(&none);
-    const sigset_t served = daemon_signals();
+    const sigset_t served = agnocast_service::service_signals();
     ::posix_spawnattr_setsigmask(&attributes_, &none);
     ::posix_spawnattr_setsigdefault(&attributes_, &served);
     ::posix_spawnattr_setflags(&attributes_, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);

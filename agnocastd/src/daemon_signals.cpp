@@ -8,10 +8,6 @@
 
 namespace agnocastd {
 
-sigset_t daemon_signals() { return agnocast_service::signal_set({SIGTERM, SIGINT, SIGHUP}); }
-
-void block_daemon_signals() { agnocast_service::block_signals(daemon_signals()); }
-
 bool stop_requested(std::chrono::milliseconds wait) {
   const int signal =
       agnocast_service::wait_for_signal(agnocast_service::signal_set({SIGTERM, SIGINT}), wait);

@@ -1,14 +1,14 @@
-// The serve loop: one poll over the exit records, the stop signals, the sweep
-// timer and the watchdog timer.
+// The serve loop: the service kit's loop (signals, watchdog, status file)
+// over the exit records and the sweep timer.
 #pragma once
 
-#include <chrono>
 #include <functional>
-#include <optional>
 #include <string>
 #include <utility>
 
+#include "agnocast/status.hpp"
 #include "agnocast/supervise.hpp"
+#include "agnocast_service/service_loop.hpp"
 #include "cleaner.hpp"
 #include "config.hpp"
 #include "counters.hpp"
@@ -19,13 +19,13 @@ namespace agnocastd {
 // What the daemon knows while it serves.
 struct Supervisor {
   Supervisor(Config config, std::function<Config()> reread_config, Host& host,
-             agnocast::ExitRecordReader& exit_records, std::string status_path,
+             agnocast::ExitRecordReader& exit_records, agnocast_service::ServiceLoop& service,
              std::string module_version)
       : config(std::move(config)),
         reread_config(std::move(reread_config)),
         host(host),
         exit_records(exit_records),
-        status_path(std::move(status_path)),
+        service(service),
         module_version(std::move(module_version)) {}
 
   Config config;  // the one in force; SIGHUP replaces it
@@ -33,12 +33,10 @@ struct Supervisor {
   std::function<Config()> reread_config;
   Host& host;
   agnocast::ExitRecordReader& exit_records;
-  std::string status_path;
+  agnocast_service::ServiceLoop& service;  // writes the status file
   std::string module_version;
   DeadProcessCollector collector;
   Counters counters;
-  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
-  std::chrono::system_clock::time_point started_at = std::chrono::system_clock::now();
 };
 
 // Cleans up after every process whose exit records wait now; sweeps when
@@ -50,14 +48,16 @@ void clean_exited_processes(Supervisor& supervisor);
 // when the new configuration is in force.
 bool reload_config(Supervisor& supervisor);
 
-// Rewrites the status file; logs (does not throw) when it cannot.
-void write_status(const Supervisor& supervisor, bool running);
+// agnocastd's fields of its status file; running, pid, uptime_s and
+// started_at are the head's.
+agnocast::DaemonStatus daemon_status(const Supervisor& supervisor,
+                                     const agnocast::ServiceStatus& head);
 
 // True when /dev/agnocast is there and answers with a compatible version.
 bool module_healthy();
 
-// Serves until SIGTERM or SIGINT; SIGHUP reloads the configuration, then
-// sweeps. Throws on a broken descriptor.
+// Sends READY=1, then serves until SIGTERM or SIGINT (STOPPING=1 sent);
+// SIGHUP reloads the configuration, then sweeps. Throws on a broken descriptor.
 void serve(Supervisor& supervisor);
 
 }  // namespace agnocastd

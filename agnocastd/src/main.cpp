@@ -11,9 +11,8 @@
 #include "agnocast/inspect.hpp"
 #include "agnocast/status.hpp"
 #include "agnocast/supervise.hpp"
-#include "agnocast_service/instance_lock.hpp"
 #include "agnocast_service/journal_log.hpp"
-#include "agnocast_service/notify.hpp"
+#include "agnocast_service/service_loop.hpp"
 #include "config.hpp"
 #include "daemon_signals.hpp"
 #include "event_loop.hpp"
@@ -119,10 +118,10 @@ void stop_module(bool loaded_here, bool unload_on_exit) {
 }
 
 int run(const agnocastd::Config& config, std::function<agnocastd::Config()> reread_config) {
-  // One daemon at a time, before touching anything.
-  const agnocast_service::InstanceLock lock{std::string(agnocast::daemon_lock_path), "agnocastd"};
-  // Stop signals queue up from here on; serve() reads them.
-  agnocastd::block_daemon_signals();
+  // One daemon at a time, before touching anything; the stop and reload
+  // signals queue from here on (stop_requested() and the serve loop read them).
+  agnocast_service::ServiceLoop service(
+      {.program = "agnocastd", .status_path = std::string(agnocast::daemon_status_path)});
   // The module, its version and the device permissions: clients need all three.
   const bool loaded_here = bring_up_module(config);
   const std::string module_version = checked_module_version(config);
@@ -141,28 +140,16 @@ int run(const agnocastd::Config& config, std::function<agnocastd::Config()> rere
     // namespace's kernel state (and so the policy) alive.
     agnocastd::apply_access_policy(config.access);
     agnocastd::SystemHost host;
-    agnocastd::Supervisor supervisor{config,
-                                     std::move(reread_config),
-                                     host,
-                                     exit_records,
-                                     std::string(agnocast::daemon_status_path),
-                                     module_version};
+    agnocastd::Supervisor supervisor{
+        config, std::move(reread_config), host, exit_records, service, module_version};
     // What died while no daemon ran: first the exits the kernel recorded, then the rest.
     agnocastd::clean_exited_processes(supervisor);
     agnocastd::sweep(host, supervisor.counters);
-    agnocastd::write_status(supervisor, /*running=*/true);
-    agnocast_service::notify("READY=1");
-    spdlog::info("agnocastd {} ready", agnocast::library_version_string);
-    try {
-      agnocastd::serve(supervisor);
-    } catch (...) {
-      agnocastd::write_status(supervisor, /*running=*/false);
-      throw;
-    }
-    agnocast_service::notify("STOPPING=1");
+    // READY=1, then serve until a stop signal (a failure's last status is the service's).
+    agnocastd::serve(supervisor);
     // Exits that raced the stop signal: nothing is left behind for the next start.
     agnocastd::clean_exited_processes(supervisor);
-    agnocastd::write_status(supervisor, /*running=*/false);
+    service.stopped();
     unload_on_exit = supervisor.config.unload_on_exit;
   }
   // The exit-record descriptor is closed now; it would keep the module busy.

@@ -124,5 +124,73 @@ TEST(DaemonStatusPaths, TheLockIsBesideTheStatusFile) {
             daemon_lock_path);
 }
 
+TEST(StatusPaths, AServiceLockIsItsStatusFileWithTheLockExtension) {
+  EXPECT_EQ(lock_path_beside(bridge_status_path), "/run/agnocast/bridge.lock");
+  EXPECT_EQ(lock_path_beside(foxglove_status_path), "/run/agnocast/foxglove.lock");
+  EXPECT_EQ(lock_path_beside(daemon_status_path), daemon_lock_path);
+  EXPECT_EQ(lock_path_beside("/tmp/x/status"), "/tmp/x/status.lock");
+}
+
+ServiceStatus bridge_head() {
+  return {"agnocast-bridge", 42, "0.1.0", ServiceState::running, 1700000000, 12, 1700000012};
+}
+
+std::string head_error_of(const std::string& text) {
+  try {
+    service_status_from_json(text);
+  } catch (const StatusFormatError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(ServiceStatusJson, TheHeadsFieldsInTheirOrder) {
+  EXPECT_EQ(to_json(bridge_head()),
+            R"({"program":"agnocast-bridge","pid":42,"version":"0.1.0","state":"running",)"
+            R"("running":true,"started_at":1700000000,"uptime_s":12,"written_at":1700000012})"
+            "\n");
+  ServiceStatus stopped = bridge_head();
+  stopped.state = ServiceState::stopped;
+  EXPECT_NE(to_json(stopped).find(R"("state":"stopped","running":false)"), std::string::npos);
+}
+
+TEST(ServiceStatusJson, ReadsBackWhatWasWrittenWhateverFollows) {
+  for (const ServiceState state :
+       {ServiceState::running, ServiceState::stopping, ServiceState::stopped}) {
+    ServiceStatus head = bridge_head();
+    head.state = state;
+    EXPECT_EQ(service_status_from_json(to_json(head)), head);
+  }
+  std::string with_body = to_json(bridge_head());
+  with_body.replace(with_body.rfind('}'), 1, R"(,"domain_id":0,"topics":[]})");
+  EXPECT_EQ(service_status_from_json(with_body), bridge_head());
+}
+
+TEST(ServiceStatusJson, AgnocastdsFileHasTheHeadToo) {
+  // agnocastd's fields restate the head's running, pid, uptime_s and started_at.
+  std::string file = to_json(bridge_head());
+  file.replace(file.rfind('}'), 1,
+               R"(,"module_loaded":true,"module_version":"0.1.0","processes_cleaned":2,)"
+               R"("queues_removed":3,"shm_removed":1})");
+  const DaemonStatus daemon = daemon_status_from_json(file);
+  EXPECT_TRUE(daemon.running);
+  EXPECT_EQ(daemon.pid, 42);
+  EXPECT_EQ(daemon.uptime_s, 12u);
+  EXPECT_EQ(service_status_from_json(file).program, "agnocast-bridge");
+}
+
+TEST(ServiceStatusJson, ABadHeadIsNamed) {
+  std::string text = to_json(bridge_head());
+  EXPECT_EQ(head_error_of(R"({"pid":42})"), R"(status file: "program" is missing)");
+  std::string bad_state = text;
+  bad_state.replace(bad_state.find("\"running\","), 10, "\"asleep\",");
+  EXPECT_EQ(head_error_of(bad_state),
+            R"(status file: "state" must be "running", "stopping" or "stopped", not "asleep")");
+  std::string disagreeing = text;
+  disagreeing.replace(disagreeing.find("true"), 4, "false");
+  EXPECT_NE(head_error_of(disagreeing).find(R"("running" must be false when)"), std::string::npos);
+  EXPECT_EQ(head_error_of("[]"), "status file: not a JSON object");
+}
+
 }  // namespace
 }  // namespace agnocast

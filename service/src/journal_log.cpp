@@ -82,7 +82,7 @@ std::unique_ptr<spdlog::formatter> log_formatter(bool to_journal, LogStyle style
 
 void set_up_logging(const std::string& program, const std::string& level, bool to_journal,
                     LogStyle style) {
-  auto logger = spdlog::stderr_logger_st(program);
+  auto logger = spdlog::stderr_logger_mt(program);
   logger->set_formatter(log_formatter(to_journal, style, program));
   logger->set_level(spdlog::level::from_str(level));
   logger->flush_on(spdlog::level::trace);

@@ -2,17 +2,14 @@
 
 #include <gtest/gtest.h>
 #include <poll.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
-#include <string>
 
 #include "agnocast_service/timer.hpp"
 #include "agnocast_service/watchdog.hpp"
+#include "fake_notify_socket.hpp"
 
 namespace agnocast_service {
 namespace {
@@ -58,36 +55,8 @@ TEST(PeriodicTimer, FiresEveryPeriodAndNeverAtZero) {
   EXPECT_FALSE(readable(never.fd(), 30ms));
 }
 
-// A datagram socket standing for systemd's NOTIFY_SOCKET.
-class FakeNotifySocket {
- public:
-  FakeNotifySocket() : path_(::testing::TempDir() + "/agnocast-service-watchdog.sock") {
-    ::unlink(path_.c_str());
-    fd_ = ::socket(AF_UNIX, SOCK_DGRAM, 0);
-    sockaddr_un address{};
-    address.sun_family = AF_UNIX;
-    std::strncpy(address.sun_path, path_.c_str(), sizeof(address.sun_path) - 1);
-    EXPECT_EQ(::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
-    ::setenv("NOTIFY_SOCKET", path_.c_str(), 1);
-  }
-  ~FakeNotifySocket() {
-    ::unsetenv("NOTIFY_SOCKET");
-    ::close(fd_);
-    ::unlink(path_.c_str());
-  }
-  std::string received() {
-    char buffer[64] = {};
-    const ssize_t length = ::recv(fd_, buffer, sizeof(buffer), MSG_DONTWAIT);
-    return length > 0 ? std::string(buffer, static_cast<std::size_t>(length)) : "";
-  }
-
- private:
-  std::string path_;
-  int fd_;
-};
-
 TEST(Watchdog, PingsOnlyWhenHealthy) {
-  FakeNotifySocket systemd;
+  FakeNotifySocket systemd("agnocast-service-watchdog");
   ::unsetenv("WATCHDOG_PID");
   ::setenv("WATCHDOG_USEC", "20000", 1);  // a ping every 10 ms
   Watchdog watchdog;

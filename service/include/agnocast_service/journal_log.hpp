@@ -38,7 +38,7 @@ std::unique_ptr<spdlog::formatter> log_formatter(bool to_journal,
 
 // Makes spdlog's default logger, named program, write to stderr at `level`
 // (spdlog's names: trace, debug, info, warn, error, critical, off), flushing every line, in the
-// journal's format when `to_journal`.
+// journal's format when `to_journal`. Any thread may log: a line is written whole.
 void set_up_logging(const std::string& program, const std::string& level, bool to_journal,
                     LogStyle style = LogStyle::timestamped);
 

@@ -1,3 +1,8 @@
+// A user type's .msg files travel from agnocast-msggen through the kernel's
+// schema into what bag record writes and topic echo --definition prints, word
+// for word (natively, @mcap/core and @foxglove/rosmsg read such a file:
+// tests/mcap-readers).
+//
 // bag play of a file agnocast did not write: @mcap/core and
 // @foxglove/rosmsg2-serialization write it in the VM (tests/mcap-readers/
 // write-foreign.mjs), with a user type known only from the .msg text in the
@@ -11,14 +16,17 @@
 #include <agnocast/agnocast.hpp>
 #include <agnocast_test/process.hpp>
 #include <chrono>
+#include <fstream>
 #include <golden_msgs/msg/wheel.hpp>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "agnocast/inspect.hpp"
+#include "agnocast/mcap/reader.hpp"
 
 namespace {
 
@@ -72,6 +80,50 @@ std::string differences(const golden_msgs::msg::Wheel& w, std::uint32_t i) {
   check(w.code == 65 + i % 26, "code");
   check(w.odometer == 9007199254740992ULL + i, "odometer");
   return out;
+}
+
+std::string msg_file(const std::string& name) {
+  std::ifstream file("/opt/agnocast/bin/" + name + ".msg", std::ios::binary);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+TEST(BagForeign, AUserTypeIsRecordedWithItsMsgFilesWordForWord) {
+  const std::string wheel = msg_file("Wheel");
+  const std::string tire = msg_file("Tire");
+  ASSERT_FALSE(wheel.empty() || tire.empty());
+  agnocast::Node node("recorded_wheel_source");
+  auto publisher =
+      node.create_publisher<golden_msgs::msg::Wheel>("/recorded_wheel", agnocast::QoS(10));
+
+  const agnocast_test::Outcome echoed =
+      agnocast_test::run_shell("agnocast-cli topic echo /recorded_wheel --definition", "echo");
+  ASSERT_EQ(echoed.code, 0) << echoed.err;
+  const std::string separator = std::string(80, '=') + "\n";
+  EXPECT_EQ(echoed.out.rfind(wheel + separator, 0), 0u) << echoed.out;
+  EXPECT_NE(echoed.out.find(separator + "MSG: golden_msgs/Tire\n" + tire), std::string::npos)
+      << echoed.out;
+
+  const pid_t recorder =
+      agnocast_test::spawn({"agnocast-cli", "bag", "record", "-o", "wheel.mcap", "/recorded_wheel"},
+                           "record.out", "record.err");
+  ASSERT_TRUE(publisher->wait_for_subscribers(1, 20s)) << slurp("record.err");
+  auto message = publisher->borrow_loaned_message();
+  message->name = "recorded";
+  publisher->publish(std::move(message));
+  ::kill(recorder, SIGINT);
+  int status = -1;
+  ASSERT_TRUE(agnocast_test::eventually(
+      [&] { return ::waitpid(recorder, &status, WNOHANG) == recorder; }, 20s));
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << slurp("record.err");
+
+  const agnocast::mcap::Reader reader("wheel.mcap");
+  ASSERT_TRUE(reader.summary());
+  ASSERT_EQ(reader.summary()->schemas.size(), 1u);
+  const agnocast::mcap::Schema& schema = reader.summary()->schemas[0];
+  EXPECT_EQ(schema.name, "golden_msgs/msg/Wheel");
+  EXPECT_EQ(std::string(schema.data.begin(), schema.data.end()), echoed.out);
 }
 
 TEST(BagForeign, AFileWrittenByMcapCorePlaysIntoALateTransientLocalSubscriberExactly) {

@@ -28,6 +28,7 @@ TEST(HeaderWriter, SnakeCaseFollowsRos2) {
   EXPECT_EQ(snake_case("TFMessage"), "tf_message");
   EXPECT_EQ(snake_case("Vector3"), "vector3");
   EXPECT_EQ(header_path("wheel_msgs", "Wheel"), "wheel_msgs/msg/wheel.hpp");
+  EXPECT_EQ(service_header_path("std_srvs", "SetBool"), "std_srvs/srv/set_bool.hpp");
 }
 
 // The .msg text as string literals that say exactly its bytes: quotes,
@@ -51,23 +52,33 @@ TEST(HeaderWriter, DefinitionIsALiteralOfTheFilesBytes) {
   EXPECT_NE(write_header(spec).find("definition =\n      \"\";\n"), std::string::npos);
 }
 
-// Regenerate the expected files with: agnocast-msggen --package golden_msgs
-//   --output-dir tests/golden/expected --include std_msgs=... --include geometry_msgs=...
-//   tests/golden/golden_msgs/msg/*.msg
+// Regenerate the expected files, in agnocast-msggen/, with:
+//   agnocast-msggen --package golden_msgs --output-dir tests/golden/expected
+//     --include golden_msgs=tests/golden/golden_msgs/msg
+//     --include std_msgs=../messages/std_msgs/msg
+//     --include geometry_msgs=../messages/geometry_msgs/msg
+//     --include builtin_interfaces=../messages/builtin_interfaces/msg
+//     tests/golden/golden_msgs/msg/*.msg tests/golden/golden_msgs/srv/*.srv
 TEST(HeaderWriter, MatchesGoldenHeaders) {
   MessageSet set;
   for (const char* package : {"std_msgs", "geometry_msgs", "builtin_interfaces"}) {
     set.add_package_folder(package, standard / package / "msg");
   }
+  set.add_package_folder("golden_msgs", golden / "golden_msgs/msg");
   for (const char* name : {"Empty", "Tire", "Wheel"}) {
     set.add_input("golden_msgs", golden / "golden_msgs/msg" / (std::string(name) + ".msg"));
   }
+  set.add_input("golden_msgs", golden / "golden_msgs/srv/Steer.srv");
   set.resolve();
   ASSERT_EQ(set.inputs().size(), 3u);
   for (const MessageSpec& spec : set.inputs()) {
     const auto expected = golden / "expected" / header_path(spec.package, spec.name);
     EXPECT_EQ(write_header(spec), read(expected)) << "differs from " << expected;
   }
+  ASSERT_EQ(set.services().size(), 1u);
+  const ServiceSpec& steer = set.services()[0];
+  const auto expected = golden / "expected" / service_header_path(steer.package, steer.name);
+  EXPECT_EQ(write_service_header(steer), read(expected)) << "differs from " << expected;
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// agnocast-msggen: ROS 2 .msg files in, agnocast C++ headers out.
+// agnocast-msggen: ROS 2 .msg and .srv files in, agnocast C++ headers out.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -28,20 +28,22 @@ void write_if_changed(const std::filesystem::path& path, const std::string& cont
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Generates agnocast message headers from ROS 2 .msg files"};
+  CLI::App app{"Generates agnocast message headers from ROS 2 .msg and .srv files"};
   std::string package;
   std::filesystem::path output;
   std::vector<std::string> includes;
   std::vector<std::filesystem::path> files;
   std::filesystem::path constant_list;
   app.add_option("--package", package, "package of the input messages")->required();
-  app.add_option("--output-dir", output, "headers go to DIR/<package>/msg/<name>.hpp")->required();
+  app.add_option("--output-dir", output, "headers go to DIR/<package>/msg/<name>.hpp (.srv: srv/)")
+      ->required();
   app.add_option("--include", includes,
                  "PKG=DIR: where the .msg files of a package the inputs refer to are")
       ->allow_extra_args(false);
-  app.add_option("--constant-list", constant_list,
-                 "also writes FILE: AGNOCAST_CONSTANT(Message, NAME) per constant of the inputs");
-  app.add_option("files", files, ".msg files of the package")->required();
+  app.add_option(
+      "--constant-list", constant_list,
+      "also writes FILE: AGNOCAST_CONSTANT(Message, NAME) per constant of the .msg inputs");
+  app.add_option("files", files, ".msg and .srv files of the package")->required();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -63,6 +65,10 @@ int main(int argc, char** argv) {
     for (const msggen::MessageSpec& spec : messages.inputs()) {
       write_if_changed(output / msggen::header_path(spec.package, spec.name),
                        msggen::write_header(spec));
+    }
+    for (const msggen::ServiceSpec& spec : messages.services()) {
+      write_if_changed(output / msggen::service_header_path(spec.package, spec.name),
+                       msggen::write_service_header(spec));
     }
     if (!constant_list.empty()) {
       write_if_changed(constant_list, msggen::write_constant_list(messages.inputs()));

@@ -15,14 +15,22 @@ std::string key(const std::string& package, const std::string& name) {
   return package + "/" + name;
 }
 
-}  // namespace
-
-MessageSpec read_message_file(const std::string& package, const std::filesystem::path& file) {
+std::string read_text(const std::filesystem::path& file) {
   std::ifstream stream(file);
   if (!stream) throw InputError(file.string(), 0, "cannot read the file");
   std::ostringstream text;
   text << stream.rdbuf();
-  return parse_message(text.str(), file.string(), package, file.stem().string());
+  return text.str();
+}
+
+}  // namespace
+
+MessageSpec read_message_file(const std::string& package, const std::filesystem::path& file) {
+  return parse_message(read_text(file), file.string(), package, file.stem().string());
+}
+
+ServiceSpec read_service_file(const std::string& package, const std::filesystem::path& file) {
+  return parse_service(read_text(file), file.string(), package, file.stem().string());
 }
 
 void MessageSet::add_package_folder(const std::string& package,
@@ -31,6 +39,10 @@ void MessageSet::add_package_folder(const std::string& package,
 }
 
 void MessageSet::add_input(const std::string& package, const std::filesystem::path& file) {
+  if (file.extension() == ".srv") {
+    service_files_.emplace_back(package, file);
+    return;
+  }
   input_files_.emplace_back(package, file);
   input_by_type_[key(package, file.stem().string())] = file;
 }
@@ -76,6 +88,15 @@ void MessageSet::resolve() {
     std::vector<std::string> path;
     check_acyclic(spec, path);
     inputs_.push_back(spec);
+  }
+  services_.clear();
+  for (const auto& [package, file] : service_files_) {
+    ServiceSpec spec = read_service_file(package, file);
+    for (const MessageSpec* part : {&spec.request, &spec.response}) {
+      std::vector<std::string> path;
+      check_acyclic(*part, path);
+    }
+    services_.push_back(std::move(spec));
   }
 }
 

@@ -1,4 +1,4 @@
-// What one .msg file says, after parsing and before resolving other messages.
+// What one .msg or .srv file says, after parsing and before resolving other messages.
 #pragma once
 
 #include <cstdint>
@@ -73,11 +73,23 @@ struct Constant {
 struct MessageSpec {
   std::string package;
   std::string name;
+  // "msg", or "srv" for a service's request and response: the namespace
+  // package::kind, the type name "package/kind/name" and the header's folder.
+  std::string kind = "msg";
   std::string file;
-  std::string text;                   // the file as read: its definition for bags and tools
+  std::string text;  // the file (a service's: its part) as read, for bags and tools
   std::vector<std::string> comments;  // the block before the first member
   std::vector<Constant> constants;
   std::vector<Field> fields;
+};
+
+// A .srv file: two messages, Name_Request and Name_Response, of kind "srv".
+struct ServiceSpec {
+  std::string package;
+  std::string name;
+  std::string file;
+  MessageSpec request;
+  MessageSpec response;
 };
 
 bool is_primitive(BaseType type);

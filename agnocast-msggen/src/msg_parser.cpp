@@ -158,16 +158,26 @@ std::string_view split_comment(std::string_view line, std::string_view& comment)
   return line;
 }
 
+// The line between a service's request and its response.
+bool is_separator(std::string_view line) {
+  std::string_view comment;
+  return trim(split_comment(line, comment)) == "---";
+}
+
 class Parser {
  public:
-  Parser(const std::string& file, const std::string& package, const std::string& name) {
+  Parser(const std::string& file, const std::string& package, const std::string& name,
+         const std::string& kind) {
     spec_.file = file;
     spec_.package = package;
     spec_.name = name;
+    spec_.kind = kind;
   }
 
-  MessageSpec run(std::string_view text) {
-    int line_number = 0;
+  // `text` starts at line `first_line` of the file.
+  MessageSpec run(std::string_view text, int first_line) {
+    spec_.text = std::string(text);
+    int line_number = first_line - 1;
     while (!text.empty()) {
       const std::size_t end = text.find('\n');
       std::string_view line = text.substr(0, end);
@@ -285,24 +295,70 @@ class Parser {
   bool seen_member_ = false;
 };
 
-}  // namespace
-
-bool is_primitive(BaseType type) { return type != BaseType::String && type != BaseType::Message; }
-
-MessageSpec parse_message(std::string_view text, const std::string& file,
-                          const std::string& package, const std::string& name) {
+void check_package_name(const std::string& file, const std::string& package) {
   if (!is_lower_identifier(package)) {
     throw InputError(file, 0,
                      fmt::format("bad package name '{}': lower case letters, digits and "
                                  "single underscores",
                                  package));
   }
+}
+
+void check_type_name(const std::string& file, const std::string& name, std::string_view what) {
   if (!is_type_name(name)) {
     throw InputError(file, 0,
-                     fmt::format("bad message name '{}': CamelCase letters and digits", name));
+                     fmt::format("bad {} name '{}': CamelCase letters and digits", what, name));
   }
-  MessageSpec spec = Parser(file, package, name).run(text);
-  spec.text = std::string(text);
+}
+
+}  // namespace
+
+bool is_primitive(BaseType type) { return type != BaseType::String && type != BaseType::Message; }
+
+MessageSpec parse_message(std::string_view text, const std::string& file,
+                          const std::string& package, const std::string& name) {
+  check_package_name(file, package);
+  check_type_name(file, name, "message");
+  return Parser(file, package, name, "msg").run(text, 1);
+}
+
+ServiceSpec parse_service(std::string_view text, const std::string& file,
+                          const std::string& package, const std::string& name) {
+  check_package_name(file, package);
+  check_type_name(file, name, "service");
+  // Where the separator line starts and where the line after it starts.
+  std::size_t separator = std::string_view::npos;
+  std::size_t response_start = 0;
+  int separator_line = 0;
+  int line_number = 0;
+  for (std::size_t start = 0; start < text.size();) {
+    const std::size_t end = text.find('\n', start);
+    const std::size_t next = end == std::string_view::npos ? text.size() : end + 1;
+    ++line_number;
+    if (is_separator(text.substr(start, next - start))) {
+      if (separator != std::string_view::npos) {
+        throw InputError(file, line_number,
+                         fmt::format("a second '---' (the first is on line {}): a service has "
+                                     "one request and one response",
+                                     separator_line));
+      }
+      separator = start;
+      response_start = next;
+      separator_line = line_number;
+    }
+    start = next;
+  }
+  if (separator == std::string_view::npos) {
+    throw InputError(file, 0,
+                     "no line '---': a service is a request, a line '---', then a response");
+  }
+  ServiceSpec spec;
+  spec.package = package;
+  spec.name = name;
+  spec.file = file;
+  spec.request = Parser(file, package, name + "_Request", "srv").run(text.substr(0, separator), 1);
+  spec.response = Parser(file, package, name + "_Response", "srv")
+                      .run(text.substr(response_start), separator_line + 1);
   return spec;
 }
 

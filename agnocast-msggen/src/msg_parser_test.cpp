@@ -156,6 +156,119 @@ TEST(MsgParser, BadMessageOrPackageNameIsAboutTheFile) {
   EXPECT_THROW(parse_message("int32 a\n", "x/M.msg", "Pkg", "M"), InputError);
 }
 
+ServiceSpec parse_srv(std::string_view text) {
+  return parse_service(text, "p/srv/S.srv", "p", "S");
+}
+
+// The error message of parsing `text` as a .srv file, or "" when it parses.
+std::string service_error_of(std::string_view text) {
+  try {
+    parse_srv(text);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(SrvParser, SplitsRequestAndResponseAtTheSeparator) {
+  const std::string text =
+      "# about the request\n\n"
+      "int32 LIMIT=3\n"
+      "int64 a 1  # first\n"
+      "Other b\n"
+      "---\n"
+      "int32 LIMIT=4\n"
+      "string<=8 a\n";
+  const ServiceSpec spec = parse_srv(text);
+  EXPECT_EQ(spec.package, "p");
+  EXPECT_EQ(spec.name, "S");
+  EXPECT_EQ(spec.request.name, "S_Request");
+  EXPECT_EQ(spec.response.name, "S_Response");
+  EXPECT_EQ(spec.request.kind, "srv");
+  EXPECT_EQ(spec.response.kind, "srv");
+  EXPECT_EQ(spec.request.comments, std::vector<std::string>{"about the request"});
+  ASSERT_EQ(spec.request.constants.size(), 1u);
+  EXPECT_EQ(spec.request.constants[0].initializer, "3");
+  ASSERT_EQ(spec.request.fields.size(), 2u);
+  EXPECT_EQ(*spec.request.fields[0].default_initializer, "1LL");
+  EXPECT_EQ(spec.request.fields[0].comments, std::vector<std::string>{"first"});
+  // A type of the same package is a message of the package, not a part of a service.
+  EXPECT_EQ(spec.request.fields[1].type.package, "p");
+  EXPECT_EQ(spec.request.fields[1].type.name, "Other");
+  // The same names may appear in both parts; lines count from the file's start.
+  ASSERT_EQ(spec.response.constants.size(), 1u);
+  EXPECT_EQ(spec.response.constants[0].initializer, "4");
+  ASSERT_EQ(spec.response.fields.size(), 1u);
+  EXPECT_EQ(spec.response.fields[0].type.string_bound, 8u);
+  EXPECT_EQ(spec.response.fields[0].line, 8);
+  // Each part's text is its lines of the file; the separator belongs to neither.
+  EXPECT_EQ(spec.request.text, text.substr(0, text.find("---\n")));
+  EXPECT_EQ(spec.response.text, "int32 LIMIT=4\nstring<=8 a\n");
+}
+
+TEST(SrvParser, EmptyPartsGetThePlaceholderMember) {
+  const ServiceSpec spec = parse_srv("---");
+  EXPECT_EQ(spec.request.text, "");
+  EXPECT_EQ(spec.response.text, "");
+  ASSERT_EQ(spec.request.fields.size(), 1u);
+  EXPECT_EQ(spec.request.fields[0].name, "structure_needs_at_least_one_member");
+  ASSERT_EQ(spec.response.fields.size(), 1u);
+  EXPECT_EQ(spec.response.fields[0].name, "structure_needs_at_least_one_member");
+  // A comment on the separator line is a comment.
+  EXPECT_EQ(parse_srv("bool a\n  ---  # then\nbool b\n").response.fields[0].name, "b");
+}
+
+TEST(SrvParser, ErrorsNameFileLineAndCause) {
+  EXPECT_EQ(service_error_of("int32 a\nint32 b\n"),
+            "p/srv/S.srv: no line '---': a service is a request, a line '---', then a response");
+  EXPECT_EQ(service_error_of(""),
+            "p/srv/S.srv: no line '---': a service is a request, a line '---', then a response");
+  EXPECT_EQ(service_error_of("int32 a\n---\nint32 b\n---\nint32 c\n"),
+            "p/srv/S.srv:4: a second '---' (the first is on line 2): a service has one request "
+            "and one response");
+  // Errors in either part are located in the file.
+  EXPECT_EQ(service_error_of("int32 a\nfloat33 b\n---\n"),
+            "p/srv/S.srv:2: unknown type 'float33': not a primitive type, and not a message name "
+            "(CamelCase)");
+  EXPECT_EQ(service_error_of("int32 a\n---\nint32 b\n\nint64 b\n"),
+            "p/srv/S.srv:5: duplicate field or constant 'b'");
+  EXPECT_EQ(service_error_of("---\nuint8 u 256\n"), "p/srv/S.srv:2: 256 is out of range [0, 255]");
+  EXPECT_EQ(service_error_of("---\nstring<=2 S=abc\n"),
+            "p/srv/S.srv:2: the string has 3 characters, more than its bound 2");
+  // A part's name is Name_Request: the service's name has no underscore.
+  try {
+    parse_service("---\n", "x/srv/lower.srv", "p", "lower");
+    FAIL() << "a lower-case service name was accepted";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "x/srv/lower.srv: bad service name 'lower': CamelCase letters and digits");
+  }
+  EXPECT_THROW(parse_service("---\n", "x/srv/S.srv", "Pkg", "S"), InputError);
+}
+
+TEST(MessageSet, ServiceTypesAreResolved) {
+  const std::filesystem::path golden = GOLDEN_DIR;
+  MessageSet set;
+  set.add_input("golden_msgs", golden / "golden_msgs/srv/Steer.srv");
+  set.add_package_folder("golden_msgs", golden / "golden_msgs/msg");
+  try {
+    set.resolve();
+    FAIL() << "resolved without the folder of std_msgs";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              (golden / "golden_msgs/srv/Steer.srv").string() +
+                  ":18: unknown type 'std_msgs/Header': no Header.msg among the inputs or in the "
+                  "folders given for package 'std_msgs' (DEPENDENCIES / --include)");
+  }
+  const std::filesystem::path standard = golden / "../../../messages";
+  set.add_package_folder("std_msgs", standard / "std_msgs/msg");
+  set.add_package_folder("builtin_interfaces", standard / "builtin_interfaces/msg");
+  set.resolve();
+  EXPECT_TRUE(set.inputs().empty());
+  ASSERT_EQ(set.services().size(), 1u);
+  EXPECT_EQ(set.services()[0].name, "Steer");
+}
+
 TEST(MessageSet, UnknownTypeNamesWhereToLook) {
   const std::filesystem::path golden = GOLDEN_DIR;
   MessageSet set;

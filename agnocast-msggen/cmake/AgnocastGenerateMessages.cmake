@@ -1,14 +1,17 @@
-# agnocast_generate_messages(<target> PACKAGE <package> FILES <file.msg>...
+# agnocast_generate_messages(<target> PACKAGE <package> FILES <file.msg or file.srv>...
 #                            [DEPENDENCIES <package or target>...] [PYTHON])
 #
-# Generates <package>/msg/<snake_case>.hpp for each .msg file and makes <target>,
-# an INTERFACE library to link: it carries the include folder, agnocast::agnocast
-# and the targets of the dependencies. The FILES of one package live in one folder.
+# Generates <package>/msg/<snake_case>.hpp for each .msg file and
+# <package>/srv/<snake_case>.hpp for each .srv file, and makes <target>, an
+# INTERFACE library to link: it carries the include folder, agnocast::agnocast
+# and the targets of the dependencies. The .msg FILES of one package live in one
+# folder (its msg/), the .srv FILES in one folder (its srv/).
 # A dependency is a target made by this function, or a package of the standard
 # set (std_msgs, geometry_msgs, sensor_msgs, nav_msgs, ...: agnocast::<name>).
 # PYTHON also makes <target>_python, which writes the Python message module
 # <dir>/agnocast/msg/<package>.py (see AgnocastPythonMessages.cmake); <dir> is
 # the target's property AGNOCAST_PYTHON_DIR, for PYTHONPATH or installation.
+# Services have no Python module yet: PYTHON writes the messages only.
 
 include(${CMAKE_CURRENT_LIST_DIR}/AgnocastPythonMessages.cmake)
 
@@ -33,19 +36,35 @@ function(agnocast_generate_messages target)
 
   set(output_dir ${CMAKE_CURRENT_BINARY_DIR}/agnocast_messages/${target})
   set(inputs "")
+  set(msg_files "")
+  set(srv_files "")
   set(headers "")
   foreach(file IN LISTS arg_FILES)
     get_filename_component(file "${file}" ABSOLUTE)
     get_filename_component(name "${file}" NAME_WE)
+    get_filename_component(extension "${file}" LAST_EXT)
     _agnocast_snake_case(${name} snake)
+    if(extension STREQUAL ".msg")
+      list(APPEND msg_files ${file})
+      list(APPEND headers ${output_dir}/${arg_PACKAGE}/msg/${snake}.hpp)
+    elseif(extension STREQUAL ".srv")
+      list(APPEND srv_files ${file})
+      list(APPEND headers ${output_dir}/${arg_PACKAGE}/srv/${snake}.hpp)
+    else()
+      message(FATAL_ERROR "agnocast_generate_messages(${target}): '${file}' is neither a .msg "
+                          "nor a .srv file")
+    endif()
     list(APPEND inputs ${file})
-    list(APPEND headers ${output_dir}/${arg_PACKAGE}/msg/${snake}.hpp)
   endforeach()
-  list(GET inputs 0 first_input)
-  get_filename_component(msg_dir "${first_input}" DIRECTORY)
 
-  # Every package reachable through the dependencies, as PKG=DIR for --include.
-  set(includes "${arg_PACKAGE}=${msg_dir}")
+  # Every package reachable through the dependencies, as PKG=DIR for --include;
+  # the package's own folder of .msg files first, if it has any.
+  set(includes "")
+  if(msg_files)
+    list(GET msg_files 0 first_msg)
+    get_filename_component(msg_dir "${first_msg}" DIRECTORY)
+    set(includes "${arg_PACKAGE}=${msg_dir}")
+  endif()
   set(dependency_targets "")
   set(dependency_files "")
   foreach(dependency IN LISTS arg_DEPENDENCIES)
@@ -87,7 +106,8 @@ function(agnocast_generate_messages target)
   set_target_properties(${target} PROPERTIES
     AGNOCAST_MSG_INCLUDES "${includes}"
     AGNOCAST_PACKAGE ${arg_PACKAGE}
-    AGNOCAST_MSG_FILES "${inputs}"
+    AGNOCAST_MSG_FILES "${msg_files}"
+    AGNOCAST_SRV_FILES "${srv_files}"
     AGNOCAST_CONSTANT_LIST ${constant_list}
     AGNOCAST_HEADER_DIR ${output_dir})
   if(arg_PYTHON)

@@ -1,10 +1,11 @@
 # agnocast_python_messages(<target> OUTPUT_DIR <dir> PACKAGES <message target>...)
 #
 # Writes <dir>/agnocast/msg/<package>.py for each message target made by
-# agnocast_generate_messages: one agnocast.MessageType per message, built from
-# the schema blob of the generated C++ type (name, layout hash, every field's
-# offset and size, as the compiler laid it out). A small program compiled
-# once for all the packages prints them; no binding is compiled per type.
+# agnocast_generate_messages: one agnocast.MessageType per message (services
+# are left out for now), built from the schema blob of the generated C++ type
+# (name, layout hash, every field's offset and size, as the compiler laid it
+# out). A small program compiled once for all the packages prints them; no
+# binding is compiled per type.
 # <target> builds the modules; add <dir> to PYTHONPATH (or install the files
 # into a dist-packages folder's agnocast/msg) to import them.
 
@@ -20,9 +21,12 @@ function(agnocast_python_messages target)
   foreach(package_target IN LISTS arg_PACKAGES)
     get_target_property(package ${package_target} AGNOCAST_PACKAGE)
     get_target_property(files ${package_target} AGNOCAST_MSG_FILES)
-    if(NOT package OR NOT files)
+    if(NOT package)
       message(FATAL_ERROR "agnocast_python_messages(${target}): '${package_target}' is not a "
                           "target of agnocast_generate_messages")
+    endif()
+    if(NOT files)
+      set(files "")  # a package of services only: no message types for Python yet
     endif()
     string(APPEND emits "  {\n    Module out(argv[1], \"${package}\");\n")
     foreach(file IN LISTS files)

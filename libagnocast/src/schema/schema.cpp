@@ -9,7 +9,6 @@
 namespace agnocast {
 namespace {
 
-constexpr std::size_t header_bytes = 20;
 constexpr std::size_t type_fixed_bytes = 8 + 4 + 4 + 2 + 1;
 constexpr std::size_t field_fixed_bytes = 1 + 1 + 1 + 2 + 7 * 4;
 

@@ -22,6 +22,7 @@
 #include <linux/string.h>
 
 #include "agnocast_internal.h"
+#include "agnocast_trace.h"
 
 static struct kmem_cache *agnocast_entry_cache;
 
@@ -59,6 +60,7 @@ static void agnocast_entry_unref(struct agnocast_topic_entry *entry)
 	lockdep_assert_held(&topic->lock);
 	if (WARN_ON_ONCE(!entry->refs) || --entry->refs)
 		return;
+	trace_reclaim(entry);
 	list_del(&entry->node);
 	topic->nr_entries--;
 	if (owner) {
@@ -113,7 +115,10 @@ static void agnocast_sub_push(struct agnocast_subscriber *sub,
 			      struct agnocast_topic_entry *entry)
 {
 	if (sub->nr_unreceived == sub->ep.depth) {
-		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
+		struct agnocast_topic_entry *oldest = agnocast_sub_pop_oldest(sub);
+
+		trace_drop(sub, oldest, AGNOCAST_DROP_DEPTH);
+		agnocast_entry_unref(oldest);
 		sub->dropped++;
 	}
 	sub->unreceived[(sub->head + sub->nr_unreceived) % sub->ep.depth] = entry;
@@ -189,6 +194,7 @@ u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic
 		agnocast_entry_leave_window(list_first_entry(&pub->window,
 							     struct agnocast_topic_entry,
 							     window_node));
+	trace_publish(pub, entry, bytes, nr_wake);
 	return nr_wake;
 }
 
@@ -226,15 +232,21 @@ void agnocast_sub_fill_transient(struct agnocast_subscriber *sub)
 	sub->nr_unreceived = n;
 }
 
-/* Drops every unreceived and held reference of @sub. */
+/* Drops every unreceived and held reference of @sub, which goes. */
 void agnocast_sub_drop_entries(struct agnocast_subscriber *sub)
 {
+	struct agnocast_topic_entry *entry;
 	u32 i;
 
-	while (sub->nr_unreceived)
-		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
-	for (i = 0; i < sub->nr_held; i++)
+	while (sub->nr_unreceived) {
+		entry = agnocast_sub_pop_oldest(sub);
+		trace_drop(sub, entry, AGNOCAST_DROP_REMOVED);
+		agnocast_entry_unref(entry);
+	}
+	for (i = 0; i < sub->nr_held; i++) {
+		trace_release(sub, sub->held[i]);
 		agnocast_entry_unref(sub->held[i]);
+	}
 	sub->nr_held = 0;
 }
 
@@ -328,6 +340,7 @@ void agnocast_sub_receive(struct agnocast_subscriber *sub, struct agnocast_entry
 	lockdep_assert_held(&sub->ep.topic->lock);
 	for (i = 0; i < n; i++) {
 		agnocast_entry_out(&out[i], sub->unreceived[sub->head]);
+		trace_receive(sub, sub->unreceived[sub->head], n);
 		agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
 	}
 }
@@ -338,10 +351,16 @@ void agnocast_sub_receive(struct agnocast_subscriber *sub, struct agnocast_entry
  */
 void agnocast_sub_take_newest(struct agnocast_subscriber *sub, struct agnocast_entry *out)
 {
+	struct agnocast_topic_entry *entry;
+
 	lockdep_assert_held(&sub->ep.topic->lock);
-	while (sub->nr_unreceived > 1)
-		agnocast_entry_unref(agnocast_sub_pop_oldest(sub));
+	while (sub->nr_unreceived > 1) {
+		entry = agnocast_sub_pop_oldest(sub);
+		trace_drop(sub, entry, AGNOCAST_DROP_PASSED_OVER);
+		agnocast_entry_unref(entry);
+	}
 	agnocast_entry_out(out, sub->unreceived[sub->head]);
+	trace_receive(sub, sub->unreceived[sub->head], 1);
 	agnocast_sub_hold(sub, agnocast_sub_pop_oldest(sub));
 }
 
@@ -410,7 +429,10 @@ int agnocast_sub_release(struct agnocast_subscriber *sub, const u64 *ids, u32 n)
 		return 0;
 	for (r = w = first; r < sub->nr_held; r++) {
 		if (agnocast_held_listed(sub->held[r])) {
-			agnocast_entry_unref(agnocast_held_flip(sub->held[r]));
+			struct agnocast_topic_entry *entry = agnocast_held_flip(sub->held[r]);
+
+			trace_release(sub, entry);
+			agnocast_entry_unref(entry);
 			continue;
 		}
 		sub->held[w++] = sub->held[r];
@@ -431,6 +453,7 @@ static u32 agnocast_sub_shed(struct agnocast_subscriber *sub, struct agnocast_me
 		struct agnocast_topic_entry *entry = agnocast_sub_unreceived(sub, i);
 
 		if (entry->pool == pool && !entry->publisher) {
+			trace_shed(sub, entry);
 			agnocast_entry_unref(entry);
 			shed++;
 			continue;

@@ -21,6 +21,9 @@
 #include <linux/uaccess.h>
 
 #include "agnocast_internal.h"
+/* The one place the trace events are defined. */
+#define CREATE_TRACE_POINTS
+#include "agnocast_trace.h"
 
 unsigned long agnocast_pool_size = 1UL << 30;
 module_param_named(pool_size, agnocast_pool_size, ulong, 0444);

@@ -35,6 +35,7 @@
 #include <linux/tracepoint.h>
 
 #include "agnocast_internal.h"
+#include "agnocast_trace.h"
 
 static DEFINE_RAW_SPINLOCK(agnocast_proc_table_lock);
 static DEFINE_HASHTABLE(agnocast_proc_table, 10);
@@ -89,6 +90,7 @@ static void agnocast_proc_teardown(struct agnocast_proc *proc, bool record)
 	hash_del_rcu(&proc->table_node);
 	raw_spin_unlock(&agnocast_proc_table_lock);
 
+	trace_process_exit(proc, record);
 	if (record)
 		agnocast_queue_exit_records(proc);
 	agnocast_wake_publisher_gone(proc);

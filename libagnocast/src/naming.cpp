@@ -71,4 +71,63 @@ std::optional<QueueNameParts> parse_queue_name(std::string_view name) {
   return parts;
 }
 
+namespace {
+
+// The rest of the topic after prefix when prefix is its first component(s), else nullopt.
+std::optional<std::string_view> below_prefix(std::string_view topic, std::string_view prefix) {
+  if (!topic.starts_with(prefix)) return std::nullopt;
+  const std::string_view rest = topic.substr(prefix.size());
+  if (!rest.empty() && rest.front() != '/') return std::nullopt;
+  return rest;
+}
+
+}  // namespace
+
+std::string service_name_problem(std::string_view service) {
+  std::string problem = topic_name_problem(service);
+  if (!problem.empty()) {
+    const std::string_view topic_word = "topic name";
+    if (problem.starts_with(topic_word)) problem.replace(0, topic_word.size(), "service name");
+    return problem;
+  }
+  if (service.size() > service_name_max) {
+    return "service name '" + std::string(service) + "' is too long: at most " +
+           std::to_string(service_name_max) + " characters, so that its request topic fits";
+  }
+  if (is_service_topic(service)) {
+    return "service name '" + std::string(service) + "' must not start with " +
+           std::string(service_request_prefix) + " or " + std::string(service_reply_prefix);
+  }
+  return {};
+}
+
+void validate_service_name(std::string_view service) {
+  if (std::string problem = service_name_problem(service); !problem.empty()) {
+    throw std::invalid_argument(problem);
+  }
+}
+
+std::string service_request_topic(std::string_view service) {
+  return std::string(service_request_prefix) + std::string(service);
+}
+
+std::string service_reply_topic(std::string_view service) {
+  return std::string(service_reply_prefix) + std::string(service);
+}
+
+std::optional<ServiceTopic> service_of_topic(std::string_view topic) {
+  if (auto rest = below_prefix(topic, service_request_prefix); rest && !rest->empty()) {
+    return ServiceTopic{std::string(*rest), ServiceTopicRole::request};
+  }
+  if (auto rest = below_prefix(topic, service_reply_prefix); rest && !rest->empty()) {
+    return ServiceTopic{std::string(*rest), ServiceTopicRole::reply};
+  }
+  return std::nullopt;
+}
+
+bool is_service_topic(std::string_view topic) {
+  return below_prefix(topic, service_request_prefix).has_value() ||
+         below_prefix(topic, service_reply_prefix).has_value();
+}
+
 }  // namespace agnocast

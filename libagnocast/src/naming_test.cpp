@@ -84,3 +84,35 @@ TEST(QueueName, RejectsForeignNames) {
 
 }  // namespace
 }  // namespace agnocast
+
+TEST(ServiceName, TwoTopicsPerServiceAndBack) {
+  EXPECT_EQ(agnocast::service_request_topic("/arm/enable"), "/_service_request/arm/enable");
+  EXPECT_EQ(agnocast::service_reply_topic("/arm/enable"), "/_service_reply/arm/enable");
+  const auto request = agnocast::service_of_topic("/_service_request/arm/enable");
+  ASSERT_TRUE(request);
+  EXPECT_EQ(request->service, "/arm/enable");
+  EXPECT_EQ(request->role, agnocast::ServiceTopicRole::request);
+  const auto reply = agnocast::service_of_topic("/_service_reply/x");
+  ASSERT_TRUE(reply);
+  EXPECT_EQ(reply->service, "/x");
+  EXPECT_EQ(reply->role, agnocast::ServiceTopicRole::reply);
+  // Only the whole first component is reserved.
+  EXPECT_FALSE(agnocast::service_of_topic("/_service_requests/x"));
+  EXPECT_FALSE(agnocast::service_of_topic("/_service_request"));
+  EXPECT_FALSE(agnocast::service_of_topic("/chatter"));
+  EXPECT_TRUE(agnocast::is_service_topic("/_service_request"));
+  EXPECT_FALSE(agnocast::is_service_topic("/_service_replyx"));
+}
+
+TEST(ServiceName, FollowsTopicRulesWithRoomForThePrefix) {
+  EXPECT_EQ(agnocast::service_name_problem("/add_two_ints"), "");
+  EXPECT_NE(agnocast::service_name_problem("add").find("service name 'add' must start with '/'"),
+            std::string::npos);
+  EXPECT_NE(agnocast::service_name_problem("/_service_reply/a").find("must not start with"),
+            std::string::npos);
+  const std::string longest = "/" + std::string(agnocast::service_name_max - 1, 'a');
+  EXPECT_EQ(agnocast::service_name_problem(longest), "");
+  EXPECT_TRUE(agnocast::is_valid_topic_name(agnocast::service_request_topic(longest)));
+  EXPECT_NE(agnocast::service_name_problem(longest + "a").find("too long"), std::string::npos);
+  EXPECT_THROW(agnocast::validate_service_name("/a b"), std::invalid_argument);
+}

@@ -9,8 +9,16 @@
 namespace agnocast::detail {
 
 EndpointRequest make_endpoint_request(std::string_view node, std::string_view topic, const QoS& qos,
-                                      EndpointKind kind, const MessageType& type) {
+                                      EndpointKind kind, const MessageType& type,
+                                      TopicUse use) {
   validate_topic_name(topic);
+  if (use == TopicUse::application && is_service_topic(topic)) {
+    throw std::invalid_argument("topic name '" + std::string(topic) +
+                                "' is reserved: topics under " +
+                                std::string(service_request_prefix) + " and " +
+                                std::string(service_reply_prefix) +
+                                " carry services; create a service or client instead");
+  }
   if (qos.depth() < qos_depth_min || qos.depth() > qos_depth_max) {
     throw std::invalid_argument(
         "QoS depth " + std::to_string(qos.depth()) + " is out of range: it must be between " +

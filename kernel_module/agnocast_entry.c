@@ -152,13 +152,38 @@ static void agnocast_sub_looks(struct agnocast_subscriber *sub)
 }
 
 /*
- * Makes @entry (allocated, zeroed) the newest of @pub's topic: every
- * subscriber but those ignoring @pub's process gets it unreceived, and the
- * ids of those to wake are written to @wake, which has room for the topic's
- * callback subscribers.  Returns how many were written.
+ * Whether an entry of @pub may be published without dropping anything
+ * (AGNOCAST_PUBLISH_NO_DROP): 0, -EAGAIN when a subscriber that would get it
+ * is full, -EPIPE when none would get it.  @to: the one receiver, or NULL
+ * for every subscriber that does not ignore @pub's process.
  */
-u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
-			   struct agnocast_mempool *pool, u64 addr, u64 bytes, u32 *wake)
+int agnocast_entry_admits(struct agnocast_publisher *pub, struct agnocast_subscriber *to)
+{
+	struct agnocast_endpoint *ep;
+	bool any = false;
+
+	lockdep_assert_held(&pub->ep.topic->lock);
+	if (to)
+		return to->nr_unreceived == to->ep.depth ? -EAGAIN : 0;
+	list_for_each_entry(ep, &pub->ep.topic->subscribers, topic_node) {
+		if (agnocast_sub_ignores(ep, pub))
+			continue;
+		if (agnocast_to_subscriber(ep)->nr_unreceived == ep->depth)
+			return -EAGAIN;
+		any = true;
+	}
+	return any ? 0 : -EPIPE;
+}
+
+/*
+ * Makes @entry (allocated, zeroed) the newest of @pub's topic: @to alone, or
+ * without @to every subscriber but those ignoring @pub's process, gets it
+ * unreceived, and the ids of those to wake are written to @wake, which has
+ * room for them.  Returns how many were written.
+ */
+u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_subscriber *to,
+			   struct agnocast_topic_entry *entry, struct agnocast_mempool *pool,
+			   u64 addr, u64 bytes, u32 *wake)
 {
 	struct agnocast_topic *topic = pub->ep.topic;
 	struct agnocast_subscriber *sub;
@@ -180,15 +205,21 @@ u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic
 	pub->window_len++;
 	pub->published++;
 	pub->published_bytes += bytes;
-	list_for_each_entry(ep, &topic->subscribers, topic_node) {
-		if (agnocast_sub_ignores(ep, pub))
-			continue;
-		sub = agnocast_to_subscriber(ep);
-		agnocast_sub_push(sub, entry);
-		if (!agnocast_sub_wake(sub, pub))
-			continue;
-		if (!WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
-			wake[nr_wake++] = ep->id;
+	if (to) {
+		agnocast_sub_push(to, entry);
+		if (agnocast_sub_wake(to, pub))
+			wake[nr_wake++] = to->ep.id;
+	} else {
+		list_for_each_entry(ep, &topic->subscribers, topic_node) {
+			if (agnocast_sub_ignores(ep, pub))
+				continue;
+			sub = agnocast_to_subscriber(ep);
+			agnocast_sub_push(sub, entry);
+			if (!agnocast_sub_wake(sub, pub))
+				continue;
+			if (!WARN_ON_ONCE(nr_wake == topic->nr_callback_subscribers))
+				wake[nr_wake++] = ep->id;
+		}
 	}
 	if (pub->window_len > pub->ep.depth)
 		agnocast_entry_leave_window(list_first_entry(&pub->window,

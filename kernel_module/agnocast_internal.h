@@ -406,8 +406,10 @@ int agnocast_entry_init(void);
 void agnocast_entry_exit(void);
 struct agnocast_topic_entry *agnocast_entry_alloc(void);
 void agnocast_entry_free(struct agnocast_topic_entry *entry);
-u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_topic_entry *entry,
-			   struct agnocast_mempool *pool, u64 addr, u64 bytes, u32 *wake);
+int agnocast_entry_admits(struct agnocast_publisher *pub, struct agnocast_subscriber *to);
+u32 agnocast_entry_publish(struct agnocast_publisher *pub, struct agnocast_subscriber *to,
+			   struct agnocast_topic_entry *entry, struct agnocast_mempool *pool,
+			   u64 addr, u64 bytes, u32 *wake);
 void agnocast_publisher_drop_window(struct agnocast_publisher *pub);
 struct agnocast_topic_entry *agnocast_sub_unreceived(const struct agnocast_subscriber *sub,
 						     u32 i);

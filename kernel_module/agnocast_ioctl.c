@@ -21,6 +21,7 @@
 #define AGNOCAST_WAKE_SMALL 16
 /* Entry ids a RELEASE or RECEIVE releases without allocating. */
 #define AGNOCAST_RELEASE_SMALL AGNOCAST_RECEIVE_BATCH
+#define AGNOCAST_PUBLISH_FLAGS (AGNOCAST_PUBLISH_TO_ONE | AGNOCAST_PUBLISH_NO_DROP)
 
 static int agnocast_add_endpoint(struct agnocast_ns *file_ns, void __user *uarg,
 				 bool publisher)
@@ -174,18 +175,20 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	u32 wake_small[AGNOCAST_WAKE_SMALL];
 	struct agnocast_topic_entry *entry;
 	struct agnocast_publish arg;
-	struct agnocast_endpoint *ep;
+	struct agnocast_endpoint *ep, *to_ep;
+	struct agnocast_subscriber *to = NULL;
 	struct agnocast_publisher *pub;
 	struct agnocast_mempool *pool;
 	struct agnocast_topic *topic;
 	struct agnocast_ctx ctx;
 	u32 *wake = wake_small;
-	u32 wake_max, reclaim_max, wake_count = 0;
+	u32 wake_max, reclaim_max, wake_needed, wake_count = 0;
 	int ret;
 
 	if (agnocast_words_in(&arg, uarg, sizeof(arg)))
 		return -EFAULT;
-	if (arg.reserved)
+	if (arg.reserved || (arg.flags & ~AGNOCAST_PUBLISH_FLAGS) ||
+	    (arg.to_subscriber && !(arg.flags & AGNOCAST_PUBLISH_TO_ONE)))
 		return -EINVAL;
 	wake_max = min_t(u32, arg.wake_capacity, AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX);
 	reclaim_max = min_t(u32, arg.reclaim_capacity, AGNOCAST_RECLAIM_BATCH);
@@ -210,13 +213,25 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	ret = -EFAULT;
 	if (arg.addr < pool->addr || arg.addr - pool->addr >= pool->size)
 		goto out_leave;
+	wake_needed = topic->nr_callback_subscribers;
+	if (arg.flags & AGNOCAST_PUBLISH_TO_ONE) {
+		ret = -EINVAL;
+		if (ep->flags & AGNOCAST_TRANSIENT_LOCAL)
+			goto out_leave;
+		/* Endpoints come and go under the namespace lock held for write. */
+		to_ep = xa_load(&topic->endpoints, arg.to_subscriber);
+		ret = -ENXIO;
+		if (!to_ep || to_ep->publisher || agnocast_sub_ignores(to_ep, pub))
+			goto out_leave;
+		to = agnocast_to_subscriber(to_ep);
+		wake_needed = 1;
+	}
 	ret = -ENOBUFS;
-	if (arg.wake_capacity < topic->nr_callback_subscribers)
+	if (arg.wake_capacity < wake_needed)
 		goto out_leave;
 	ret = -ENOMEM;
-	if (topic->nr_callback_subscribers > ARRAY_SIZE(wake_small)) {
-		wake = kvmalloc_array(topic->nr_callback_subscribers, sizeof(*wake),
-				      GFP_KERNEL_ACCOUNT);
+	if (wake_needed > ARRAY_SIZE(wake_small)) {
+		wake = kvmalloc_array(wake_needed, sizeof(*wake), GFP_KERNEL_ACCOUNT);
 		if (!wake)
 			goto out_leave;
 	}
@@ -224,9 +239,17 @@ int agnocast_publish(struct agnocast_ns *file_ns, void __user *uarg)
 	if (!entry)
 		goto out_leave;
 
-	/* Committed: nothing below fails. */
 	mutex_lock(&topic->lock);
-	wake_count = agnocast_entry_publish(pub, entry, pool, arg.addr, arg.bytes, wake);
+	if (arg.flags & AGNOCAST_PUBLISH_NO_DROP) {
+		ret = agnocast_entry_admits(pub, to);
+		if (ret) {
+			mutex_unlock(&topic->lock);
+			agnocast_entry_free(entry);
+			goto out_leave;
+		}
+	}
+	/* Committed: nothing below fails. */
+	wake_count = agnocast_entry_publish(pub, to, entry, pool, arg.addr, arg.bytes, wake);
 	arg.entry_id = entry->id;
 	mutex_unlock(&topic->lock);
 	arg.wake_count = wake_count;

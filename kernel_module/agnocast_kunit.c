@@ -126,7 +126,7 @@ static struct agnocast_topic_entry *agnocast_kunit_publish(struct agnocast_kunit
 
 	KUNIT_ASSERT_NOT_ERR_OR_NULL(w->test, entry);
 	mutex_lock(&w->topic.lock);
-	n = agnocast_entry_publish(pub, entry, &w->pool, w->pool.addr + offset, 64,
+	n = agnocast_entry_publish(pub, NULL, entry, &w->pool, w->pool.addr + offset, 64,
 				   wake ? wake : wake_local);
 	mutex_unlock(&w->topic.lock);
 	if (nr_wake)

@@ -45,7 +45,7 @@
 
 /* The module and the library must agree on major and minor. */
 #define AGNOCAST_VERSION_MAJOR 0
-#define AGNOCAST_VERSION_MINOR 4
+#define AGNOCAST_VERSION_MINOR 5
 #define AGNOCAST_VERSION_PATCH 0
 
 /* Including the terminating NUL. */
@@ -241,10 +241,30 @@ struct agnocast_remove_endpoint {
  * AGNOCAST_RECLAIM_BATCH addresses are returned per call; reclaim_pending
  * counts the rest.
  *
+ * flags (services build on them):
+ *   AGNOCAST_PUBLISH_TO_ONE  only the subscriber to_subscriber gets the
+ *            entry (a response to the one client that asked); wake_capacity
+ *            1 is enough.  Not on a transient-local publisher, whose window
+ *            late subscribers would get.
+ *   AGNOCAST_PUBLISH_NO_DROP the entry is refused rather than dropping a
+ *            subscriber's oldest unreceived entry, and refused when no
+ *            subscriber would get it (a request nobody will answer).
+ * Without flags to_subscriber must be 0.
+ *
  *   -EFAULT  addr is outside the caller's pool
  *   -ENOBUFS wake_capacity is below the topic's subscriber count
  *   -EBUSY   the caller's pool is not attached yet
+ *   -EINVAL  also: unknown flag, to_subscriber without TO_ONE, TO_ONE on a
+ *            transient-local publisher
+ *   -ENXIO   TO_ONE: to_subscriber is not a subscriber of the topic that
+ *            takes the publisher's entries (gone, or ignoring its process)
+ *   -EAGAIN  NO_DROP: a subscriber that would get the entry has depth
+ *            unreceived entries
+ *   -EPIPE   NO_DROP: no subscriber would get the entry
  */
+#define AGNOCAST_PUBLISH_TO_ONE (1U << 0)
+#define AGNOCAST_PUBLISH_NO_DROP (1U << 1)
+
 struct agnocast_publish {
 	__u32 topic_handle;
 	__u32 publisher_id;
@@ -258,6 +278,8 @@ struct agnocast_publish {
 	__u32 wake_count;
 	__u32 reclaim_count;
 	__u32 reclaim_pending;
+	__u32 flags;		/* AGNOCAST_PUBLISH_* */
+	__u32 to_subscriber;
 	__u32 reserved;
 };
 

@@ -59,6 +59,33 @@ class QueueError : public Error {
   int code_;
 };
 
+// create_service() of a name that has a server already; what() names the
+// service and the serving process.
+class ServiceExists : public Error {
+ public:
+  using Error::Error;
+};
+
+// A request will not be answered: no server was there, or it went away (its
+// process died, or its Service was destroyed) with the request pending.
+class ServiceUnavailable : public Error {
+ public:
+  using Error::Error;
+};
+
+// The server's request queue was full: the request was not delivered.
+class RequestRejected : public Error {
+ public:
+  using Error::Error;
+};
+
+// async_send_request() over the client's in-flight bound (its QoS depth):
+// nothing was sent. Wait for answers, or prune_pending_requests().
+class TooManyRequests : public Error {
+ public:
+  using Error::Error;
+};
+
 // The process's shared-memory pool has no room left even after reclaiming.
 class PoolExhausted : public std::bad_alloc {
  public:

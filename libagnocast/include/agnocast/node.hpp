@@ -12,6 +12,7 @@
 #include "agnocast/message_traits.hpp"
 #include "agnocast/publisher.hpp"
 #include "agnocast/qos.hpp"
+#include "agnocast/service.hpp"
 #include "agnocast/subscription.hpp"
 #include "agnocast/subscription_options.hpp"
 #include "agnocast/timer.hpp"
@@ -58,6 +59,55 @@ class Node {
       std::string_view topic, const QoS& qos, const SubscriptionOptions& options = {}) {
     static_assert(Publishable<T>, AGNOCAST_PUBLISHABLE_RULE);
     return std::make_shared<PollingSubscriber<T>>(state_, topic, qos, options);
+  }
+
+  // Serves a service name: callback takes (const ipc_shared_ptr<const
+  // Srv::Request>&, ipc_shared_ptr<Srv::Response>&) and fills the response,
+  // or, deferred, (std::shared_ptr<Service<Srv>>, RequestId,
+  // ipc_shared_ptr<const Srv::Request>) and answers later with
+  // send_response(). qos.depth(): the requests that may wait for the server
+  // before further ones are refused (RequestRejected at the client).
+  // Throws ServiceExists when the name has a server already.
+  template <ServiceType Srv, class Callback>
+  std::shared_ptr<Service<Srv>> create_service(std::string_view name, Callback&& callback,
+                                               const QoS& qos = QoS(service_queue_depth_default),
+                                               std::shared_ptr<CallbackGroup> group = nullptr) {
+    using Request = typename Srv::Request;
+    using Response = typename Srv::Response;
+    static_assert(Publishable<Request> && Publishable<Response>, AGNOCAST_PUBLISHABLE_RULE);
+    SubscriptionOptions options;
+    options.callback_group = detail::group_or_default(*state_, std::move(group));
+    std::shared_ptr<Service<Srv>> service;
+    if constexpr (std::is_invocable_v<Callback&, const ipc_shared_ptr<const Request>&,
+                                      ipc_shared_ptr<Response>&>) {
+      service = std::make_shared<Service<Srv>>(
+          state_, name, qos, typename Service<Srv>::Callback(std::forward<Callback>(callback)),
+          options);
+    } else {
+      static_assert(
+          std::is_invocable_v<Callback&, std::shared_ptr<Service<Srv>>, RequestId,
+                              ipc_shared_ptr<const Request>>,
+          "agnocast: a service callback takes (const ipc_shared_ptr<const "
+          "Srv::Request>&, ipc_shared_ptr<Srv::Response>&), or, to answer later, "
+          "(std::shared_ptr<Service<Srv>>, RequestId, ipc_shared_ptr<const Srv::Request>)");
+      service = std::make_shared<Service<Srv>>(
+          state_, name, qos,
+          typename Service<Srv>::DeferredCallback(std::forward<Callback>(callback)), options);
+    }
+    detail::register_waitable(*state_, service);
+    return service;
+  }
+
+  // Calls a service name; qos.depth() bounds the requests in flight.
+  template <ServiceType Srv>
+  std::shared_ptr<Client<Srv>> create_client(std::string_view name,
+                                             const QoS& qos = QoS(client_in_flight_default),
+                                             std::shared_ptr<CallbackGroup> group = nullptr) {
+    SubscriptionOptions options;
+    options.callback_group = detail::group_or_default(*state_, std::move(group));
+    auto client = std::make_shared<Client<Srv>>(state_, name, qos, options);
+    detail::register_waitable(*state_, client);
+    return client;
   }
 
   // Calls callback every period (steady clock) from the executor spinning

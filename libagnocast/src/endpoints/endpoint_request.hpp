@@ -11,10 +11,9 @@
 namespace agnocast::detail {
 
 struct MessageType;
+enum class TopicUse;
 
 enum class EndpointKind { publisher, callback_subscriber, polling_subscriber };
-// Applications may not use the topics that carry services (<agnocast/naming.hpp>).
-enum class TopicUse { application, service_carrier };
 
 struct EndpointRequest {
   std::string topic;
@@ -35,7 +34,6 @@ struct EndpointRequest {
 // Validates topic, depth and type name against <agnocast/limits.hpp>
 // (std::invalid_argument naming the rule) and fills the request.
 EndpointRequest make_endpoint_request(std::string_view node, std::string_view topic, const QoS& qos,
-                                      EndpointKind kind, const MessageType& type,
-                                      TopicUse use = TopicUse::application);
+                                      EndpointKind kind, const MessageType& type, TopicUse use);
 
 }  // namespace agnocast::detail

@@ -38,9 +38,9 @@ struct PublisherCore::State {
 };
 
 PublisherCore::PublisherCore(std::shared_ptr<NodeState> node, std::string_view topic,
-                             const QoS& qos, const MessageType& type) {
+                             const QoS& qos, const MessageType& type, TopicUse use) {
   const EndpointRequest request =
-      make_endpoint_request(node->name, topic, qos, EndpointKind::publisher, type);
+      make_endpoint_request(node->name, topic, qos, EndpointKind::publisher, type, use);
   state_ = std::make_unique<State>(std::move(node), Runtime::get(), request);
 }
 
@@ -80,7 +80,9 @@ bool PublisherCore::wait_for_subscribers(std::size_t count,
   }
 }
 
-void PublisherCore::publish(void* message, std::size_t bytes) {
+void PublisherCore::publish(void* message, std::size_t bytes) { publish(message, bytes, {}); }
+
+void PublisherCore::publish(void* message, std::size_t bytes, const ServiceRoute& route) {
   // The message is complete: what publishing allocates is the library's own.
   close_loan_heap_scope(message);
   State& state = *state_;
@@ -98,7 +100,7 @@ void PublisherCore::publish(void* message, std::size_t bytes) {
       try {
         result = state.runtime.kernel().publish(state.endpoint,
                                                 reinterpret_cast<std::uintptr_t>(message), bytes,
-                                                state.wake_ids, reclaimed);
+                                                state.wake_ids, reclaimed, route);
         break;
       } catch (const DeviceError& error) {
         if (error.code() == ENOBUFS && state.wake_ids.size() < subscribers_per_topic_max) {

@@ -328,10 +328,10 @@ struct SubscriptionBase::State {
 
 SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic,
                                    const QoS& qos, const MessageType& type,
-                                   const SubscriptionOptions& options)
+                                   const SubscriptionOptions& options, TopicUse use)
     : Waitable(options.callback_group), state_(std::make_unique<State>()) {
   EndpointRequest request =
-      make_endpoint_request(node->name, topic, qos, EndpointKind::callback_subscriber, type);
+      make_endpoint_request(node->name, topic, qos, EndpointKind::callback_subscriber, type, use);
   request.ignore_local = options.ignore_local_publications;
   state_->node = std::move(node);
   state_->topic = request.topic;
@@ -449,8 +449,8 @@ struct PollingCore::State {
 PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
                          const MessageType& type, const SubscriptionOptions& options)
     : state_(std::make_unique<State>()) {
-  EndpointRequest request =
-      make_endpoint_request(node->name, topic, qos, EndpointKind::polling_subscriber, type);
+  EndpointRequest request = make_endpoint_request(
+      node->name, topic, qos, EndpointKind::polling_subscriber, type, TopicUse::application);
   request.ignore_local = options.ignore_local_publications;
   state_->node = std::move(node);
   state_->topic = request.topic;

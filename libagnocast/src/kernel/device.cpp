@@ -379,8 +379,14 @@ void Device::notify_failed(EndpointId publisher, std::uint32_t subscriber_id) no
 }
 
 PublishResult Device::publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
-                              std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim) {
+                              std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim,
+                              const ServiceRoute& route) {
   agnocast_publish argument{};
+  if (route.to_subscriber) {
+    argument.flags |= AGNOCAST_PUBLISH_TO_ONE;
+    argument.to_subscriber = *route.to_subscriber;
+  }
+  if (route.no_drop) argument.flags |= AGNOCAST_PUBLISH_NO_DROP;
   argument.topic_handle = publisher.topic_handle;
   argument.publisher_id = publisher.id;
   argument.addr = addr;

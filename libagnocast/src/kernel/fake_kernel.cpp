@@ -244,7 +244,7 @@ void FakeKernel::drop_unreceived(Subscriber& subscriber, std::uint64_t entry_id)
 
 PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, std::uint64_t bytes,
                                   std::span<std::uint32_t> wake_ids,
-                                  std::span<std::uint64_t> reclaim) {
+                                  std::span<std::uint64_t> reclaim, const ServiceRoute& route) {
   std::lock_guard lock(mutex_);
   break_overdue_promises();
   ++calls_.publish;
@@ -257,7 +257,27 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
   const auto callback_subscribers =
       std::count_if(topic.subscribers.begin(), topic.subscribers.end(),
                     [](const auto& entry) { return !entry.second.polling; });
-  if (wake_ids.size() < static_cast<std::size_t>(callback_subscribers)) fail("PUBLISH", ENOBUFS);
+  const auto receives = [&](std::uint32_t id, const Subscriber& subscriber) {
+    if (subscriber.ignore_local && subscriber.pid == caller_pid_) return false;
+    return !route.to_subscriber || *route.to_subscriber == id;
+  };
+  if (route.to_subscriber) {
+    if (publisher.transient_local) fail("PUBLISH", EINVAL);
+    const auto to = topic.subscribers.find(*route.to_subscriber);
+    if (to == topic.subscribers.end() || !receives(to->first, to->second)) fail("PUBLISH", ENXIO);
+    if (wake_ids.empty()) fail("PUBLISH", ENOBUFS);
+  } else if (wake_ids.size() < static_cast<std::size_t>(callback_subscribers)) {
+    fail("PUBLISH", ENOBUFS);
+  }
+  if (route.no_drop) {
+    bool any = false;
+    for (const auto& [id, subscriber] : topic.subscribers) {
+      if (!receives(id, subscriber)) continue;
+      if (subscriber.unreceived.size() >= subscriber.depth) fail("PUBLISH", EAGAIN);
+      any = true;
+    }
+    if (!any) fail("PUBLISH", EPIPE);
+  }
 
   const std::uint64_t entry_id = next_entry_id_++;
   entries_[entry_id] =
@@ -267,7 +287,7 @@ PublishResult FakeKernel::publish(EndpointId publisher_id, std::uint64_t addr, s
   PublishResult result;
   result.entry_id = entry_id;
   for (auto& [id, subscriber] : topic.subscribers) {
-    if (subscriber.ignore_local && subscriber.pid == caller_pid_) continue;
+    if (!receives(id, subscriber)) continue;
     subscriber.unreceived.push_back(entry_id);
     ++entries_[entry_id].unreceived_by;
     if (subscriber.unreceived.size() > subscriber.depth) {

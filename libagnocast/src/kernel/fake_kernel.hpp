@@ -43,8 +43,8 @@ class FakeKernel final : public Kernel {
   void remove_publisher(EndpointId endpoint) override;
   void remove_subscriber(EndpointId endpoint) override;
   PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
-                        std::span<std::uint32_t> wake_ids,
-                        std::span<std::uint64_t> reclaim) override;
+                        std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim,
+                        const ServiceRoute& route) override;
   void notify_failed(EndpointId publisher, std::uint32_t subscriber_id) noexcept override;
   // The caller process's wake eventfd, made on first use.
   int wake_fd() const override;

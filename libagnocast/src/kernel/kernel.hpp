@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 
+#include "agnocast/detail/endpoints.hpp"
 #include "agnocast/inspect.hpp"
 #include "endpoints/endpoint_request.hpp"
 
@@ -80,10 +81,11 @@ class Kernel {
   virtual void remove_subscriber(EndpointId endpoint) = 0;
 
   // wake_ids receives the ids of callback subscribers to notify, reclaim the
-  // addresses of this process's messages no one references any more.
+  // addresses of this process's messages no one references any more. A
+  // service route's refusal is ENXIO (to_subscriber is gone), EAGAIN or EPIPE.
   virtual PublishResult publish(EndpointId publisher, std::uint64_t addr, std::uint64_t bytes,
-                                std::span<std::uint32_t> wake_ids,
-                                std::span<std::uint64_t> reclaim) = 0;
+                                std::span<std::uint32_t> wake_ids, std::span<std::uint64_t> reclaim,
+                                const ServiceRoute& route) = 0;
   // The publisher could not send the notification publish() listed
   // subscriber_id for: the kernel wakes the subscriber's process through its
   // wake_fd() and lists it again at the next publish(). Never throws.

@@ -42,8 +42,8 @@ Answer perform(Kernel& kernel, std::uint64_t pool_base, const Call& call) {
       case Call::Kind::publish: {
         std::array<std::uint32_t, Answer::max> wake{};
         std::array<std::uint64_t, Answer::max> reclaim{};
-        const PublishResult result =
-            kernel.publish(call.endpoint, pool_base + call.offset, 8, wake, reclaim);
+        const PublishResult result = kernel.publish(call.endpoint, pool_base + call.offset, 8, wake,
+                                                    reclaim, ServiceRoute{});
         answer.entry_id = result.entry_id;
         answer.wake_count = result.wake_count;
         std::copy_n(wake.begin(), result.wake_count, answer.wake_ids);

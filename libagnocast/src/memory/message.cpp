@@ -33,7 +33,7 @@ void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void
   void* message = static_cast<char*>(block) + offset;
   const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
   *header_of(message) =
-      MessageHeader{nullptr, destroy, block, &thread_counter, thread_counter, 0, 0};
+      MessageHeader{nullptr, destroy, block, &thread_counter, thread_counter, 0, 0, ServiceTag{}};
   return message;
 }
 
@@ -71,6 +71,21 @@ Publication read_publication(const void* message, const void* pool_begin,
   const auto* header =
       reinterpret_cast<const MessageHeader*>(static_cast<const char*>(message) - header_room);
   return Publication{header->publish_time, header->published_bytes};
+}
+
+void set_service_tag(void* message, const ServiceTag& tag) noexcept {
+  header_of(message)->service = tag;
+}
+
+ServiceTag read_service_tag(const void* message) noexcept {
+  const std::span<const std::byte> pool = pool_holding(message);
+  const auto at = reinterpret_cast<std::uintptr_t>(message);
+  const auto begin = reinterpret_cast<std::uintptr_t>(pool.data());
+  // Another process wrote the address: only trust a header inside its pool.
+  if (pool.empty() || at < begin + header_room || at - begin > pool.size()) return {};
+  const auto* header =
+      reinterpret_cast<const MessageHeader*>(static_cast<const char*>(message) - header_room);
+  return header->service;
 }
 
 void free_message_memory(void* message) noexcept {

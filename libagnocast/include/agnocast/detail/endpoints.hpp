@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -35,16 +36,30 @@ MessageType message_type_of() {
   return MessageType{message_traits<T>::type_name, message_traits<T>::type_hash, schema_of<T>()};
 }
 
+// Applications may not use the topics that carry services (<agnocast/naming.hpp>).
+enum class TopicUse { application, service_carrier };
+
+// Where a published message goes: to every subscriber, or to to_subscriber
+// alone (ENXIO when it is gone); no_drop refuses it (EAGAIN) rather than
+// dropping a full subscriber's oldest, and (EPIPE) when no subscriber would
+// get it. Services use both; a topic's publishers use neither.
+struct ServiceRoute {
+  std::optional<std::uint32_t> to_subscriber;
+  bool no_drop = false;
+};
+
 class PublisherCore {
  public:
   PublisherCore(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
-                const MessageType& type);
+                const MessageType& type, TopicUse use = TopicUse::application);
   ~PublisherCore();
   PublisherCore(const PublisherCore&) = delete;
   PublisherCore& operator=(const PublisherCore&) = delete;
 
   // Takes ownership of a loaned message: publishes it and wakes subscribers.
   void publish(void* message, std::size_t bytes);
+  // The same along a service's route; a refusal frees the message and throws.
+  void publish(void* message, std::size_t bytes, const ServiceRoute& route);
   const std::string& topic() const;
   std::uint32_t id() const;
   // Live subscribers of the topic, in every process.
@@ -112,7 +127,8 @@ class SubscriptionBase : public Waitable {
 
  protected:
   SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic, const QoS& qos,
-                   const MessageType& type, const SubscriptionOptions& options);
+                   const MessageType& type, const SubscriptionOptions& options,
+                   TopicUse use = TopicUse::application);
   // Must take ownership of reference (count one) even when it throws.
   virtual void deliver(const void* message, EntryReference* reference, const MessageInfo& info) = 0;
 

@@ -10,6 +10,27 @@
 
 namespace agnocast::detail {
 
+// What a service request or response carries besides its payload
+// (service.hpp); zero in a topic's messages.
+struct ServiceTag {
+  // A request's number, unique per client, echoed by its response.
+  std::uint64_t sequence = 0;
+  // A request: the client's subscriber id on the reply topic, where its
+  // response goes. A response: the server's publisher id on that topic.
+  std::uint32_t peer = 0;
+  // Which response to the request this is; always 0 (one response per request).
+  std::uint16_t response_index = 0;
+  std::uint16_t status = 0;  // ServiceStatus
+};
+
+enum class ServiceStatus : std::uint16_t {
+  none = 0,  // not a service message
+  request = 1,
+  response = 2,
+  // Sent to every client by a server that stops: what it has not answered never will be.
+  server_gone = 3,
+};
+
 // Placed right before every loaned message, in the publisher's own pool.
 // Subscribers never write it; the publisher uses it to destroy the message
 // when the kernel reports it reclaimable, even after the Publisher is gone.
@@ -27,6 +48,7 @@ struct MessageHeader {
   // Written at publish, read by subscribers for MessageInfo.
   std::int64_t publish_time;  // steady clock nanoseconds
   std::uint64_t published_bytes;
+  ServiceTag service;
 };
 
 template <class T>
@@ -59,6 +81,11 @@ Publication read_publication(const void* message, const void* pool_begin,
 // or this process's own), or an empty span: what a reader of a received
 // message may read (ForeignMemory, <agnocast/schema_walk.hpp>).
 std::span<const std::byte> pool_holding(const void* address);
+// A loan's service tag, written before it is published.
+void set_service_tag(void* message, const ServiceTag& tag) noexcept;
+// The service tag of a received message, read from the pool that holds it;
+// all zero when the header lies outside that pool.
+ServiceTag read_service_tag(const void* message) noexcept;
 // Frees memory from allocate_message whose object was never constructed.
 void free_message_memory(void* message) noexcept;
 // Destroys a constructed, unpublished message and frees its memory.

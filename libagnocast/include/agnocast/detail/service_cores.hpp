@@ -1,0 +1,98 @@
+// Non-template cores behind Service<Srv> and Client<Srv> (service.hpp); the
+// templates only add the request and response types. A service rides two
+// topics (<agnocast/naming.hpp>): requests go, without ever being dropped, to
+// the server's one subscriber; each response goes to the one client that asked.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "agnocast/detail/endpoints.hpp"
+
+namespace agnocast {
+
+// Names one request: the client (its subscriber id on the service's reply
+// topic) and the client's sequence number for it.
+struct RequestId {
+  std::uint32_t client = 0;
+  std::uint64_t sequence = 0;
+
+  bool operator==(const RequestId&) const = default;
+};
+
+}  // namespace agnocast
+
+namespace agnocast::detail {
+
+// A default-constructed response loan (allocate_message), for the word a
+// stopping server sends every client.
+using ResponseFactory = void* (*)();
+
+class ServiceCore : public SubscriptionBase {
+ public:
+  // Throws ServiceExists when the name has a server already.
+  ServiceCore(std::shared_ptr<NodeState> node, std::string_view service, const QoS& qos,
+              const MessageType& request_type, const MessageType& response_type,
+              ResponseFactory empty_response, const SubscriptionOptions& options);
+  // Tells every client that what it has not had answered never will be.
+  ~ServiceCore() override;
+
+  // Takes ownership of the loaned response and sends it to the client that
+  // asked. A client that is gone, or whose reply queue is full, does not get
+  // it (counted in failures(), never thrown).
+  void send_response(const RequestId& id, void* response, std::size_t bytes);
+  const std::string& service_name() const;
+  std::uint64_t calls() const;     // requests handed to the callback
+  std::uint64_t failures() const;  // requests refused and responses not delivered
+
+ protected:
+  // Owns reference (count one) even when it throws.
+  virtual void handle_request(const void* request, EntryReference* reference,
+                              const RequestId& id) = 0;
+
+ private:
+  void deliver(const void* message, EntryReference* reference, const MessageInfo& info) final;
+
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+class ClientCore : public SubscriptionBase {
+ public:
+  // Runs once per request, from the executor or inside send(): with the
+  // response (its reference count one, now the completion's), or with error.
+  using Completion = std::function<void(const void* response, EntryReference* reference,
+                                        std::exception_ptr error)>;
+
+  // qos.depth() bounds the requests in flight.
+  ClientCore(std::shared_ptr<NodeState> node, std::string_view service, const QoS& qos,
+             const MessageType& request_type, const MessageType& response_type,
+             const SubscriptionOptions& options);
+  ~ClientCore() override;
+
+  // Takes ownership of the loaned request. Throws TooManyRequests, with
+  // nothing sent, when the in-flight bound is reached; every other failure
+  // reaches completion.
+  RequestId send(void* request, std::size_t bytes, Completion completion);
+  bool service_is_ready() const;
+  bool wait_for_service(std::chrono::nanoseconds timeout) const;
+  // Forgets every pending request (their completions never run); returns how many.
+  std::size_t prune_pending();
+  std::size_t pending() const;
+  const std::string& service_name() const;
+
+  struct State;
+
+ private:
+  void deliver(const void* message, EntryReference* reference, const MessageInfo& info) final;
+
+  std::shared_ptr<State> state_;
+};
+
+}  // namespace agnocast::detail

@@ -18,7 +18,7 @@ static_assert(sizeof(agnocast_version) == 16);
 static_assert(sizeof(agnocast_register_process) == 32);
 static_assert(sizeof(agnocast_add_endpoint) == 552);
 static_assert(sizeof(agnocast_remove_endpoint) == 8);
-static_assert(sizeof(agnocast_publish) == 72);
+static_assert(sizeof(agnocast_publish) == 80);
 static_assert(sizeof(agnocast_reclaim) == 24);
 static_assert(sizeof(agnocast_entry) == 24);
 static_assert(sizeof(agnocast_pool) == 24);
@@ -772,6 +772,13 @@ TEST_F(Device, PublishErrors) {
   arg.addr = reg.addr;
   arg.reserved = 1;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -EINVAL);
+  arg.reserved = 0;
+  arg.flags = 1U << 7;  // unknown
+  arg.to_subscriber = 0;
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -EINVAL);
+  arg.flags = AGNOCAST_PUBLISH_NO_DROP;
+  arg.to_subscriber = 1;  // without TO_ONE
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -EINVAL);
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, static_cast<agnocast_publish*>(kBadPtr)), -EFAULT);
 
   Endpoint s1, s2, sp;
@@ -788,6 +795,8 @@ TEST_F(Device, PublishErrors) {
   arg.wake_capacity = 1;
   arg.reclaim = 0;
   arg.reclaim_capacity = 0;
+  arg.flags = 0;
+  arg.to_subscriber = 0;
   arg.reserved = 0;
   EXPECT_EQ(ioc(dev, AGNOCAST_IOC_PUBLISH, &arg), -ENOBUFS);
   arg.wake_ids = uptr(kBadPtr);
@@ -805,6 +814,102 @@ TEST_F(Device, PublishErrors) {
   EXPECT_EQ(arg.reserved, 0u);
   EXPECT_EQ(wake[0], s1.id);
   EXPECT_EQ(wake[1], s2.id);
+}
+
+static std::vector<uint32_t> unreceived_by_subscriber(int dev, const char* topic) {
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  if (topic_info(dev, topic, &info, nullptr, &subs)) return {};
+  std::vector<uint32_t> unreceived;
+  for (const auto& sub : subs) unreceived.push_back(sub.unreceived);
+  return unreceived;
+}
+
+// A response goes to the one client that asked: the others are neither
+// given the entry nor woken, and one slot of wake_ids is enough.
+TEST_F(Device, PublishToOneReachesThatSubscriberOnly) {
+  registered();
+  Endpoint pub, a, b, polling, ignoring;
+  ASSERT_EQ(add_publisher(dev, "/to_one", 2, &pub), 0);
+  ASSERT_EQ(add_subscriber(dev, "/to_one", 4, &a), 0);
+  ASSERT_EQ(add_subscriber(dev, "/to_one", 4, &b), 0);
+  ASSERT_EQ(add_subscriber(dev, "/to_one", 4, &polling, AGNOCAST_POLLING), 0);
+  ASSERT_EQ(add_subscriber(dev, "/to_one", 4, &ignoring, AGNOCAST_IGNORE_LOCAL), 0);
+
+  PublishResult res;
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64, &res, 64, AGNOCAST_PUBLISH_TO_ONE, b.id), 0);
+  ASSERT_EQ(res.wake.size(), 1u);
+  EXPECT_EQ(res.wake[0], b.id);
+  EXPECT_EQ(unreceived_by_subscriber(dev, "/to_one"), (std::vector<uint32_t>{0, 1, 0, 0}));
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, a, &rr), 0);
+  EXPECT_TRUE(rr.entries.empty());
+  ASSERT_EQ(receive(dev, b, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 1u);
+  EXPECT_EQ(rr.entries[0].entry_id, res.entry_id);
+  EXPECT_EQ(release(dev, b, res.entry_id), 0);
+
+  // A polling subscriber is given it, never woken.
+  ASSERT_EQ(publish(dev, pub, reg.addr + 128, &res, 64, AGNOCAST_PUBLISH_TO_ONE, polling.id), 0);
+  EXPECT_TRUE(res.wake.empty());
+  EXPECT_EQ(unreceived_by_subscriber(dev, "/to_one"), (std::vector<uint32_t>{0, 0, 1, 0}));
+
+  // Gone, a publisher, or ignoring the publisher's process: nothing published.
+  EXPECT_EQ(publish(dev, pub, reg.addr + 192, nullptr, 64, AGNOCAST_PUBLISH_TO_ONE, 9999), -ENXIO);
+  EXPECT_EQ(publish(dev, pub, reg.addr + 192, nullptr, 64, AGNOCAST_PUBLISH_TO_ONE, pub.id),
+            -ENXIO);
+  EXPECT_EQ(publish(dev, pub, reg.addr + 192, nullptr, 64, AGNOCAST_PUBLISH_TO_ONE, ignoring.id),
+            -ENXIO);
+  agnocast_topic_info info;
+  ASSERT_EQ(topic_info(dev, "/to_one", &info), 0);
+  EXPECT_EQ(info.entries, 2u);
+
+  // A transient-local publisher's window would reach late subscribers.
+  Endpoint latched;
+  ASSERT_EQ(add_publisher(dev, "/to_one", 2, &latched, AGNOCAST_TRANSIENT_LOCAL), 0);
+  EXPECT_EQ(publish(dev, latched, reg.addr + 192, nullptr, 64, AGNOCAST_PUBLISH_TO_ONE, a.id),
+            -EINVAL);
+}
+
+// A request is refused rather than dropping an older one, and refused when
+// nobody would get it; a refusal changes nothing.
+TEST_F(Device, PublishNoDropRefusesWhenAReceiverIsFullOrThereIsNone) {
+  registered();
+  Endpoint pub, server, other;
+  ASSERT_EQ(add_publisher(dev, "/no_drop", 1, &pub), 0);
+  EXPECT_EQ(publish(dev, pub, reg.addr + 64, nullptr, 64, AGNOCAST_PUBLISH_NO_DROP), -EPIPE);
+  ASSERT_EQ(add_subscriber(dev, "/no_drop", 2, &server), 0);
+  ASSERT_EQ(add_subscriber(dev, "/no_drop", 1, &other), 0);
+  PublishResult res;
+  ASSERT_EQ(publish(dev, pub, reg.addr + 64, &res, 64,
+                    AGNOCAST_PUBLISH_NO_DROP | AGNOCAST_PUBLISH_TO_ONE, server.id),
+            0);
+  ASSERT_EQ(publish(dev, pub, reg.addr + 128, &res, 64,
+                    AGNOCAST_PUBLISH_NO_DROP | AGNOCAST_PUBLISH_TO_ONE, server.id),
+            0);
+  EXPECT_EQ(publish(dev, pub, reg.addr + 192, nullptr, 64,
+                    AGNOCAST_PUBLISH_NO_DROP | AGNOCAST_PUBLISH_TO_ONE, server.id),
+            -EAGAIN);
+  // To everyone: the full one refuses it for all.
+  EXPECT_EQ(publish(dev, pub, reg.addr + 192, nullptr, 64, AGNOCAST_PUBLISH_NO_DROP), -EAGAIN);
+  agnocast_topic_info info;
+  std::vector<agnocast_subscriber_info> subs;
+  ASSERT_EQ(topic_info(dev, "/no_drop", &info, nullptr, &subs), 0);
+  ASSERT_EQ(subs.size(), 2u);
+  EXPECT_EQ(subs[0].unreceived, 2u);
+  EXPECT_EQ(subs[0].dropped, 0u);
+  EXPECT_EQ(subs[1].unreceived, 0u);
+  EXPECT_EQ(info.entries, 2u);
+
+  // Once it receives, there is room again.
+  ReceiveResult rr;
+  ASSERT_EQ(receive(dev, server, &rr), 0);
+  ASSERT_EQ(rr.entries.size(), 2u);
+  EXPECT_EQ(publish(dev, pub, reg.addr + 192, nullptr, 64, AGNOCAST_PUBLISH_NO_DROP), 0);
+  // Without the flag, a full subscriber drops its oldest as before.
+  EXPECT_EQ(publish(dev, pub, reg.addr + 256, nullptr, 64), 0);
+  ASSERT_EQ(topic_info(dev, "/no_drop", &info, nullptr, &subs), 0);
+  EXPECT_EQ(subs[1].dropped, 1u);
 }
 
 TEST_F(Device, Reclaim) {

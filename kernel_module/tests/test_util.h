@@ -173,8 +173,9 @@ struct PublishResult {
   uint32_t reclaim_pending = 0;
 };
 
+// flags/to_subscriber: AGNOCAST_PUBLISH_TO_ONE, AGNOCAST_PUBLISH_NO_DROP.
 inline int publish(int dev, Endpoint pub, uint64_t addr, PublishResult *res = nullptr,
-                   uint32_t reclaim_capacity = 64)
+                   uint32_t reclaim_capacity = 64, uint32_t flags = 0, uint32_t to_subscriber = 0)
 {
   std::vector<uint32_t> wake(AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX, 0xA5A5A5A5u);
   std::vector<uint64_t> reclaim(reclaim_capacity + 1, 0xA5A5A5A5A5A5A5A5ull);
@@ -187,6 +188,8 @@ inline int publish(int dev, Endpoint pub, uint64_t addr, PublishResult *res = nu
   arg.wake_capacity = static_cast<uint32_t>(wake.size());
   arg.reclaim = uptr(reclaim.data());
   arg.reclaim_capacity = reclaim_capacity;
+  arg.flags = flags;
+  arg.to_subscriber = to_subscriber;
   arg.reserved = 0;
   int ret = ioc(dev, AGNOCAST_IOC_PUBLISH, &arg);
   if (!ret && res) {

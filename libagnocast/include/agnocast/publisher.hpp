@@ -3,12 +3,11 @@
 #include <chrono>
 #include <cstddef>
 #include <memory>
-#include <new>
-#include <stdexcept>
 #include <type_traits>
 #include <utility>
 
 #include "agnocast/detail/endpoints.hpp"
+#include "agnocast/detail/loan.hpp"
 #include "agnocast/heap_scope.hpp"
 #include "agnocast/ipc_shared_ptr.hpp"
 
@@ -29,26 +28,13 @@ class Publisher {
   // For a heap message (AGNOCAST_HEAP_MESSAGE), this thread allocates in the
   // pool until the loan is published or dropped (heap_scope.hpp).
   ipc_shared_ptr<T> borrow_loaned_message() {
-    void* memory =
-        detail::allocate_message(sizeof(T), alignof(T), &detail::destroy_message_object<T>);
-    T* message;
-    try {
-      if constexpr (HeapMessage<T>) detail::open_loan_heap_scope(memory);
-      message = new (memory) T();
-    } catch (...) {
-      detail::free_message_memory(memory);
-      throw;
-    }
-    return detail::MessageAccess::loan(message);
+    return detail::MessageAccess::loan(detail::borrow_loan<T>());
   }
 
   // Zero-copy: hands the loan to every subscriber. message is empty afterwards.
   void publish(ipc_shared_ptr<T>&& message) {
-    T* loaned = detail::MessageAccess::release_loan(message);
-    if (!loaned) {
-      throw std::invalid_argument(
-          "agnocast: publish needs a message from borrow_loaned_message() not yet published");
-    }
+    T* loaned = detail::loan_to_send(
+        message, "publish needs a message from borrow_loaned_message() not yet published");
     core_.publish(loaned, detail::published_bytes(loaned, sizeof(T)));
   }
 

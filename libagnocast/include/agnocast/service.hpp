@@ -8,11 +8,10 @@
 #include <functional>
 #include <future>
 #include <memory>
-#include <new>
-#include <stdexcept>
 #include <type_traits>
 #include <utility>
 
+#include "agnocast/detail/loan.hpp"
 #include "agnocast/detail/service_cores.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/heap_scope.hpp"
@@ -30,34 +29,11 @@ inline constexpr std::size_t client_in_flight_default = 10;
 
 namespace detail {
 
-// A default-constructed T in this process's pool (Publisher::borrow_loaned_message).
-template <class T>
-T* borrow_loan() {
-  void* memory = allocate_message(sizeof(T), alignof(T), &destroy_message_object<T>);
-  try {
-    if constexpr (HeapMessage<T>) open_loan_heap_scope(memory);
-    return new (memory) T();
-  } catch (...) {
-    free_message_memory(memory);
-    throw;
-  }
-}
-
 template <class T>
 void* borrow_empty_loan() {
   T* message = borrow_loan<T>();
   close_loan_heap_scope(message);
   return message;
-}
-
-template <class T>
-T* loan_to_send(ipc_shared_ptr<T>& loan, const char* what) {
-  T* loaned = MessageAccess::release_loan(loan);
-  if (!loaned) {
-    throw std::invalid_argument(std::string("agnocast: ") + what +
-                                " needs a loan not yet sent (borrow it first)");
-  }
-  return loaned;
 }
 
 }  // namespace detail
@@ -96,7 +72,8 @@ class Service : public detail::ServiceCore, public std::enable_shared_from_this<
   // Sends the response to the client whose request id names; response is
   // empty afterwards. A client that is gone does not get it (no error).
   void send_response(const RequestId& id, ipc_shared_ptr<Response>&& response) {
-    Response* loaned = detail::loan_to_send(response, "send_response");
+    Response* loaned = detail::loan_to_send(
+        response, "send_response needs a response from borrow_loaned_response() not yet sent");
     detail::close_loan_heap_scope(loaned);
     ServiceCore::send_response(id, loaned, detail::published_bytes(loaned, sizeof(Response)));
   }
@@ -149,7 +126,8 @@ class Client : public detail::ClientCore {
   // The same; callback(future) runs once the future is ready.
   SharedFuture async_send_request(ipc_shared_ptr<Request>&& request,
                                   std::function<void(SharedFuture)> callback) {
-    Request* loaned = detail::loan_to_send(request, "async_send_request");
+    Request* loaned = detail::loan_to_send(
+        request, "async_send_request needs a request from borrow_loaned_request() not yet sent");
     detail::close_loan_heap_scope(loaned);
     auto promise = std::make_shared<std::promise<ipc_shared_ptr<const Response>>>();
     SharedFuture future = promise->get_future().share();

@@ -42,8 +42,11 @@ Answer perform(Kernel& kernel, std::uint64_t pool_base, const Call& call) {
       case Call::Kind::publish: {
         std::array<std::uint32_t, Answer::max> wake{};
         std::array<std::uint64_t, Answer::max> reclaim{};
-        const PublishResult result = kernel.publish(call.endpoint, pool_base + call.offset, 8, wake,
-                                                    reclaim, ServiceRoute{});
+        ServiceRoute route;
+        if (call.to_one) route.to_subscriber = call.subscriber_id;
+        route.no_drop = call.no_drop;
+        const PublishResult result =
+            kernel.publish(call.endpoint, pool_base + call.offset, 8, wake, reclaim, route);
         answer.entry_id = result.entry_id;
         answer.wake_count = result.wake_count;
         std::copy_n(wake.begin(), result.wake_count, answer.wake_ids);
@@ -137,6 +140,16 @@ Step& Step::releasing(std::vector<std::string> entries) {
 
 Step& Step::fails(int err) {
   error = err;
+  return *this;
+}
+
+Step& Step::to(std::string one) {
+  subscriber = std::move(one);
+  return *this;
+}
+
+Step& Step::without_drops() {
+  no_drop = true;
   return *this;
 }
 
@@ -375,6 +388,32 @@ const std::vector<Scenario>& scenarios() {
         publish("p", "e2"), publish("p", "e3").reclaims({}), take("q").gets({"e3"}),
         counts("q", {.unreceived = 0, .held = 1, .received = 1, .dropped = 0}), take("q").gets({}),
         reclaim(0).reclaims({"e1", "e2"}), live_entries(1)}},
+
+      // Services' routes.
+      {"ToOneReachesThatSubscriberAlone",
+       "a PUBLISH to one subscriber gives the entry to it alone and lists it alone",
+       3,
+       {subscriber(1, "a", wake_once), subscriber(2, "b", wake_once), publisher(0, "p", 2),
+        publish("p", "e1").to("b").lists({"b"}), receive("a").gets({}), receive("b").gets({"e1"}),
+        counts("a", {}), counts("b", {.unreceived = 0, .held = 1, .received = 1, .dropped = 0}),
+        publish("p", "e2").to("a").lists({"a"}), receive("b").gets({})}},
+      {"ToOneOfAGoneSubscriberPublishesNothing",
+       "a PUBLISH to a subscriber that is gone fails with ENXIO and leaves no entry",
+       2,
+       {subscriber(1, "a", wake_once), publisher(0, "p"), kill(1),
+        publish("p", "e1").to("a").fails(ENXIO), live_entries(0)}},
+      {"NoDropRefusesRatherThanDrop",
+       "a PUBLISH without drops to a full subscriber fails with EAGAIN and drops nothing",
+       2,
+       {subscriber(1, "s", wake_once, 1), publisher(0, "p", 1),
+        publish("p", "e1").without_drops().lists({"s"}),
+        publish("p", "e2").without_drops().fails(EAGAIN),
+        counts("s", {.unreceived = 1, .held = 0, .received = 0, .dropped = 0}), live_entries(1),
+        receive("s").gets({"e1"}), publish("p", "e3").without_drops().lists({"s"})}},
+      {"NoDropWithNobodyToGetItIsRefused",
+       "a PUBLISH without drops that no subscriber would get fails with EPIPE",
+       2,
+       {publisher(0, "p"), publish("p", "e1").without_drops().fails(EPIPE), live_entries(0)}},
   };
   return table;
 }
@@ -401,7 +440,9 @@ std::string describe(const Step& step) {
     case Step::Kind::subscriber:
       return "process " + std::to_string(step.process) + " adds subscriber " + step.endpoint;
     case Step::Kind::publish:
-      return "publish " + step.endpoint + " as " + step.entry + (step.process >= 0 ? by : "");
+      return "publish " + step.endpoint + " as " + step.entry +
+             (step.subscriber.empty() ? "" : " to " + step.subscriber) +
+             (step.no_drop ? " without drops" : "") + (step.process >= 0 ? by : "");
     case Step::Kind::notify_failed:
       return "notify_failed " + step.endpoint + " for " + step.subscriber +
              (step.process >= 0 ? by : "");
@@ -544,6 +585,9 @@ class Run {
         std::uint64_t& next = next_offset_.at(static_cast<std::size_t>(process));
         call.offset = next;
         next += 64;
+        call.to_one = !step.subscriber.empty();
+        if (call.to_one) call.subscriber_id = endpoint(step.subscriber).id.id;
+        call.no_drop = step.no_drop;
         if (next > pool_block) throw std::logic_error("the scenario publishes too much");
         break;
       }

@@ -54,6 +54,8 @@ struct Call {
   EndpointId endpoint;
   std::uint32_t subscriber_id = 0;
   std::uint64_t offset = 0;    // publish: where in the caller's pool block
+  bool to_one = false;         // publish: to subscriber_id alone
+  bool no_drop = false;        // publish: refused rather than dropping or reaching no one
   std::uint32_t id_count = 0;  // release, and receive's release list
   std::uint64_t ids[ids_max] = {};
 };
@@ -130,7 +132,8 @@ struct Step {
   int process = -1;      // -1: the process of the endpoint named
   std::string endpoint;  // the endpoint made or acted through
   std::string entry;     // publish: the name its entry gets
-  std::string subscriber;
+  std::string subscriber;  // notify_failed; publish: the one it goes to (to())
+  bool no_drop = false;    // publish (without_drops())
   std::vector<std::string> ids;  // entries; a name never published stands for an id never issued
   std::uint32_t depth = 1;
   Flavor flavor;
@@ -148,6 +151,11 @@ struct Step {
   Step& reclaims(std::vector<std::string> entries);
   Step& releasing(std::vector<std::string> entries);
   Step& fails(int err);
+  // publish: to that subscriber alone (a service's response).
+  Step& to(std::string subscriber);
+  // publish: refused rather than dropping an unreceived entry or reaching no
+  // one (a service's request).
+  Step& without_drops();
   Step& by(int process);
 };
 

@@ -1,7 +1,7 @@
 # bash completion for agnocast-cli: commands, subcommands, options, and the
-# names of live topics and nodes, which agnocast-cli itself lists.
+# names of live topics, services and nodes, which agnocast-cli itself lists.
 
-_agnocast_cli_names() {  # topic | node: the first column of `agnocast-cli X list`
+_agnocast_cli_names() {  # topic | service | node: the first column of `agnocast-cli X list`
   agnocast-cli "$1" list 2>/dev/null | awk 'NR > 1 && $1 != "" { print $1 }'
 }
 
@@ -19,7 +19,7 @@ _agnocast_cli() {
   esac
   local candidates
   case "${words[0]-} ${words[1]-}" in
-    " ") candidates="topic queue node process daemon doctor policy bag version --json --help --version" ;;
+    " ") candidates="topic service queue node process daemon doctor policy bag version --json --help --version" ;;
     "bag ") candidates="record info play" ;;
     "bag record")
       if [[ $cur == -* ]]; then
@@ -41,6 +41,7 @@ _agnocast_cli() {
       fi
       ;;
     "topic ") candidates="list info hz echo" ;;
+    "service ") candidates="list info type" ;;
     "queue ") candidates="list" ;;
     "node ") candidates="list info" ;;
     "process ") candidates="list" ;;
@@ -55,6 +56,13 @@ _agnocast_cli() {
         esac
       else
         candidates=$(_agnocast_cli_names topic)
+      fi
+      ;;
+    "service info" | "service type")
+      if [[ $cur == -* || ${#words[@]} -ge 3 ]]; then
+        candidates="--json --help"
+      else
+        candidates=$(_agnocast_cli_names service)
       fi
       ;;
     "node info")

@@ -104,11 +104,12 @@ int run_cli(int argc, const char* const* argv_given, InspectionSource& source, s
   const std::vector<const char*> args = with_version_flag_as_command(argc, argv_given);
   const char* const* argv = args.data();
   Context context{source, false, std::nullopt};
-  CLI::App app{"agnocast-cli: inspect agnocast topics, queues, nodes and the daemon",
+  CLI::App app{"agnocast-cli: inspect agnocast topics, services, queues, nodes and the daemon",
                "agnocast-cli"};
   app.require_subcommand(1);
   add_json_flag(app, context);
   set_topic_command(app, context);
+  set_service_command(app, context);
   set_queue_command(app, context);
   set_node_command(app, context);
   set_process_command(app, context);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "agnocast/status.hpp"
+#include "commands.hpp"
 #include "fake_source.hpp"
 
 namespace agnocast::cli {
@@ -57,6 +58,7 @@ TEST(Cli, EveryCommandRunsOnAHealthySystem) {
       {"daemon", "status"},
       {"doctor"},
       {"policy", "show"},
+      {"service", "list"},
       {"version"}};
   for (const auto& command : commands) {
     for (bool json : {false, true}) {
@@ -91,7 +93,7 @@ TEST(Cli, AnUnknownCommandIsNamedWithTheValidOnes) {
   Outcome r = run(source, {"frobnicate"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("unknown command 'frobnicate' for 'agnocast-cli'; valid commands: topic, "
-                       "queue, node, process, daemon, doctor, policy, version"),
+                       "service, queue, node, process, daemon, doctor, policy, version"),
             std::string::npos)
       << r.err;
   r = run(source, {"--json", "topic", "lsit"});
@@ -199,6 +201,92 @@ TEST(Cli, DaemonStatusShowsTheBridgeAndFoxgloveFromTheirFiles) {
   EXPECT_NE(table.out.find("agnocast-bridge    yes"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("agnocast-foxglove  no"), std::string::npos) << table.out;
   EXPECT_EQ(table.err, "");  // only a stopped agnocastd is worth a hint
+}
+
+TEST(Cli, ServiceCommandsTableAndJson) {
+  FakeSource source = system_with_service();
+  Outcome r = run(source, {"service", "list"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("NAME         TYPE                  SERVER  CLIENTS\n", 0), 0u) << r.out;
+  r = run(source, {"--json", "service", "list"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out), service_list_json(source));
+  r = run(source, {"service", "info", "/arm/enable", "--json"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out), service_info_json(source, "/arm/enable"));
+  r = run(source, {"service", "info", "/arm/enable"});
+  EXPECT_EQ(r.out, service_info_table(service_info_json(source, "/arm/enable")));
+  r = run(source, {"service", "type", "/arm/enable"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "std_srvs/srv/SetBool\n");
+  r = run(source, {"service", "type", "/arm/enable", "--json"});
+  EXPECT_EQ(nlohmann::json::parse(r.out)["type"], "std_srvs/srv/SetBool");
+}
+
+TEST(Cli, AnUnknownServiceExitsOne) {
+  FakeSource source = system_with_service();
+  for (const char* command : {"info", "type"}) {
+    Outcome r = run(source, {"service", command, "/nope"});
+    EXPECT_EQ(r.code, 1) << command;
+    EXPECT_EQ(r.out, "");
+    EXPECT_NE(r.err.find("no server or client uses service '/nope'"), std::string::npos) << r.err;
+    r = run(source, {"--json", "service", command, "/nope"});
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(nlohmann::json::parse(r.out)["exit_code"], 1);
+  }
+}
+
+TEST(Cli, BadServiceInputIsAUsageError) {
+  FakeSource source = system_with_service();
+  const std::vector<std::vector<const char*>> commands = {
+      {"service"},
+      {"service", "info"},
+      {"service", "type"},
+      {"service", "info", "arm/enable"},
+      {"service", "info", "/arm//enable"},
+      {"service", "type", "/arm enable"},
+      {"service", "info", "/_service_request/arm/enable"},
+      {"service", "info", "/arm/enable", "/extra"},
+      {"service", "list", "--bogus"},
+      {"service", "info", "/arm/enable", "--count", "1"},
+      {"service", "call", "/arm/enable"},
+      {"service", "lsit"}};
+  for (const auto& args : commands) {
+    const Outcome r = run(source, args);
+    EXPECT_EQ(r.code, 2) << args.back();
+    EXPECT_EQ(r.out, "");
+    EXPECT_NE(r.err.find("agnocast-cli: "), std::string::npos);
+  }
+  Outcome r = run(source, {"service", "info", "/_service_reply/x"});
+  EXPECT_NE(r.err.find("must not start with /_service_request or /_service_reply"),
+            std::string::npos)
+      << r.err;
+  r = run(source, {"service", "lsit"});
+  EXPECT_NE(r.err.find("unknown command 'lsit' for 'agnocast-cli service'; valid commands: list, "
+                       "info, type"),
+            std::string::npos)
+      << r.err;
+  r = run(source, {"--json", "service", "info", "bad"});
+  EXPECT_EQ(nlohmann::json::parse(r.out)["exit_code"], 2);
+}
+
+TEST(Cli, TopicEchoRefusesATopicThatCarriesAService) {
+  FakeSource source = system_with_service();
+  const Outcome r = run(source, {"topic", "echo", "/_service_reply/arm/enable", "--count", "1"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("carries the responses of service '/arm/enable'"), std::string::npos)
+      << r.err;
+}
+
+TEST(Cli, ServiceTopicsAreLeftOutOfTopicAndQueueLists) {
+  FakeSource source = system_with_service();
+  for (const char* command : {"topic", "queue"}) {
+    const Outcome r = run(source, {command, "list"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.out.find("_service_"), std::string::npos) << r.out;
+    const Outcome json = run(source, {command, "list", "--json"});
+    EXPECT_EQ(json.out.find("_service_"), std::string::npos) << json.out;
+  }
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "agnocast/naming.hpp"
 #include "agnocast/status.hpp"
 #include "cli.hpp"
 #include "inspection_source.hpp"
@@ -57,6 +58,31 @@ struct EchoOptions {
 void set_topic_echo_command(CLI::App& topic, Context& context);
 // Writes the messages to `out`; returns the exit code, throws CliError on a timeout.
 int topic_echo(InspectionSource& source, const EchoOptions& options, std::ostream& out);
+
+// service list | info NAME | type NAME, read from the two topics that carry
+// each service. A client is a request publisher and a reply subscriber of one
+// (pid, node), paired in id order; its calls are the publisher's published
+// count, its answers its reply subscriber's received + unreceived, and the
+// difference (never below 0) is in flight. A service's failures are the
+// requests its server's request subscriber dropped.
+void set_service_command(CLI::App& app, Context& context);
+nlohmann::json service_list_json(InspectionSource& source);
+// These throw CliError when no endpoint of the service exists.
+nlohmann::json service_info_json(InspectionSource& source, const std::string& service);
+nlohmann::json service_type_json(InspectionSource& source, const std::string& service);
+std::string service_list_table(const nlohmann::json& value);
+std::string service_info_table(const nlohmann::json& value);
+std::string service_type_table(const nlohmann::json& value);
+// "std_srvs/srv/SetBool" from the type of the request topic
+// ("std_srvs/srv/SetBool_Request") or of the reply topic ("..._Response");
+// empty for a type of neither form.
+std::string service_type_of(const std::string& topic_type, ServiceTopicRole role);
+// Whether an endpoint on a topic that carries a service is its server's (the
+// request subscriber, the reply publisher) rather than a client's.
+bool is_server_endpoint(ServiceTopicRole role, bool publisher);
+// Why a command that subscribes refuses a topic that carries a service
+// (nobody but its server and clients may use it), empty for any other topic.
+std::string service_topic_refusal(const std::string& topic);
 
 void set_queue_command(CLI::App& app, Context& context);
 nlohmann::json queue_list_json(InspectionSource& source);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "agnocast/errors.hpp"
+#include "agnocast/service_access.hpp"
 #include "fake_source.hpp"
 
 namespace agnocast::cli {
@@ -148,16 +149,19 @@ TEST(NodeList, GroupsEndpointsByProcessAndLabel) {
   source.topics.push_back(status);
   const json value = node_list_json(source);
   EXPECT_EQ(value, json::parse(R"({"nodes":[
-      {"name":"monitor","pid":100,"publishes":[],"subscribes":["/status"]},
-      {"name":"talker","pid":100,"publishes":["/chatter","/status"],"subscribes":[]},
-      {"name":"listener","pid":200,"publishes":[],"subscribes":["/chatter"]},
-      {"name":"poller","pid":300,"publishes":[],"subscribes":["/chatter"]}]})"));
+      {"name":"monitor","pid":100,"publishes":[],"subscribes":["/status"],"serves":[],"calls":[]},
+      {"name":"talker","pid":100,"publishes":["/chatter","/status"],"subscribes":[],"serves":[],
+       "calls":[]},
+      {"name":"listener","pid":200,"publishes":[],"subscribes":["/chatter"],"serves":[],
+       "calls":[]},
+      {"name":"poller","pid":300,"publishes":[],"subscribes":["/chatter"],"serves":[],
+       "calls":[]}]})"));
   EXPECT_EQ(node_list_table(value),
-            "NAME      PID  PUBLISHES         SUBSCRIBES\n"
-            "monitor   100  -                 /status\n"
-            "talker    100  /chatter,/status  -\n"
-            "listener  200  -                 /chatter\n"
-            "poller    300  -                 /chatter\n");
+            "NAME      PID  PUBLISHES         SUBSCRIBES  SERVES  CALLS\n"
+            "monitor   100  -                 /status     -       -\n"
+            "talker    100  /chatter,/status  -           -       -\n"
+            "listener  200  -                 /chatter    -       -\n"
+            "poller    300  -                 /chatter    -       -\n");
 }
 
 TEST(NodeInfo, PidsAndTopicsWithTypesOfOneLabel) {
@@ -173,7 +177,7 @@ TEST(NodeInfo, PidsAndTopicsWithTypesOfOneLabel) {
   EXPECT_EQ(value, json::parse(R"({"name":"talker","pids":[100,101],
       "publishers":[{"topic":"/chatter","type":"chatter/msg/Message"},
                     {"topic":"/status","type":null}],
-      "subscribers":[]})"));
+      "subscribers":[],"servers":[],"clients":[]})"));
   EXPECT_EQ(node_info_table(value),
             "node talker\n"
             "pids 100,101\n"
@@ -499,17 +503,75 @@ TEST(PolicyShow, RulesInOrderWithNamesOrIdsAndNullForUnlistedDirections) {
 TEST(PolicyShow, TableGoldenText) {
   FakeSource source = policy_system();
   EXPECT_EQ(policy_show_table(policy_show_json(source)),
-            "default: allow (topics no rule matches, and directions a rule leaves open)\n"
-            "TOPICS      PUBLISH               SUBSCRIBE\n"
-            "/safety/**  group:safety          group:agnocast,user:monitor\n"
-            "/private/*  user:1234,group:4321  (nobody)\n"
-            "/open       (default)             *\n");
+            "default: allow (what no rule matches, and rights a rule leaves open)\n"
+            "RULE               PUBLISH               SUBSCRIBE\n"
+            "topics /safety/**  group:safety          group:agnocast,user:monitor\n"
+            "topics /private/*  user:1234,group:4321  (nobody)\n"
+            "topics /open       (default)             *\n");
   source.policy = AccessPolicy{false, {}};
   EXPECT_EQ(policy_show_json(source),
             json::parse(R"({"policy": {"default": "deny", "rules": []}})"));
   EXPECT_EQ(policy_show_table(policy_show_json(source)),
-            "default: deny (topics no rule matches, and directions a rule leaves open)\n"
+            "default: deny (what no rule matches, and rights a rule leaves open)\n"
             "no rules\n");
+}
+
+// policy_system() with a services rule between its topic rules and one for every service.
+FakeSource policy_system_with_services() {
+  using Kind = AccessPrincipal::Kind;
+  FakeSource source = policy_system();
+  std::vector<AccessRule>& rules = source.policy->rules;
+  const auto arm = topic_rules_of({"/arm/*", std::vector<AccessPrincipal>{{Kind::user, 0}},
+                                   std::vector<AccessPrincipal>{{Kind::group, 990}}});
+  rules.insert(rules.begin() + 1, arm.begin(), arm.end());
+  for (const AccessRule& rule :
+       topic_rules_of({"/**", std::nullopt, std::vector<AccessPrincipal>{}})) {
+    rules.push_back(rule);
+  }
+  return source;
+}
+
+TEST(PolicyShow, ServicesRulesShowAsWrittenInPlace) {
+  FakeSource source = policy_system_with_services();
+  ASSERT_EQ(source.policy->rules.size(), 7u);
+  EXPECT_EQ(policy_show_json(source), json::parse(R"({"policy": {"default": "allow", "rules": [
+    {"topics": "/safety/**", "publish": ["group:safety"],
+     "subscribe": ["group:agnocast", "user:monitor"]},
+    {"services": "/arm/*", "serve": ["user:root"], "call": ["group:agnocast"]},
+    {"topics": "/private/*", "publish": ["user:1234", "group:4321"], "subscribe": []},
+    {"topics": "/open", "publish": null, "subscribe": ["*"]},
+    {"services": "/**", "serve": null, "call": []}]}})"));
+  EXPECT_EQ(policy_show_table(policy_show_json(source)),
+            "default: allow (what no rule matches, and rights a rule leaves open)\n"
+            "RULE               PUBLISH               SUBSCRIBE                    SERVE      "
+            "CALL\n"
+            "topics /safety/**  group:safety          group:agnocast,user:monitor\n"
+            "services /arm/*                                                       user:root  "
+            "group:agnocast\n"
+            "topics /private/*  user:1234,group:4321  (nobody)\n"
+            "topics /open       (default)             *\n"
+            "services /**                                                          (default)  "
+            "(nobody)\n");
+}
+
+TEST(PolicyShow, OnlyServicesRulesShowOnlyTheirRights) {
+  FakeSource source = policy_system();
+  source.policy->rules.clear();
+  for (const AccessRule& rule : topic_rules_of({"/arm/enable", std::nullopt, std::nullopt})) {
+    source.policy->rules.push_back(rule);
+  }
+  EXPECT_EQ(policy_show_table(policy_show_json(source)),
+            "default: allow (what no rule matches, and rights a rule leaves open)\n"
+            "RULE                  SERVE      CALL\n"
+            "services /arm/enable  (default)  (default)\n");
+}
+
+TEST(PolicyShow, ARuleOnAServiceTopicThatNoServicesRuleMakesShowsAsATopicRule) {
+  FakeSource source = policy_system();
+  source.policy->rules = {{"/_service_request/arm/*", std::nullopt, std::nullopt}};
+  EXPECT_EQ(policy_show_json(source)["policy"]["rules"],
+            json::parse(R"([{"topics": "/_service_request/arm/*", "publish": null,
+                             "subscribe": null}])"));
 }
 
 TEST(PolicyShow, ModuleAbsentThrowsModuleNotLoaded) {

@@ -84,8 +84,12 @@ void set_topic_echo_command(CLI::App& topic, Context& context) {
       "echo", "Subscribe and print each message, decoded from the schema its publisher registered");
   echo->add_option("TOPIC", options->topic, "Topic name, e.g. /chatter")
       ->required()
-      ->check(CLI::Validator([](std::string& name) { return topic_name_problem(name); }, "TOPIC",
-                             "topic name"));
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            const std::string problem = topic_name_problem(name);
+            return problem.empty() ? service_topic_refusal(name) : problem;
+          },
+          "TOPIC", "topic name"));
   echo->add_option("--count", options->count, "Stop after N messages (exit 0)")
       ->check(CLI::PositiveNumber);
   echo->add_option("--timeout", options->timeout_s,

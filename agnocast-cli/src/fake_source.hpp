@@ -219,4 +219,74 @@ inline FakeSource healthy_system() {
   return source;
 }
 
+// healthy_system() with service /arm/enable (std_srvs/srv/SetBool): server
+// node arm_driver (pid 400) and three clients: one of node panel (pid 500),
+// two of node planner (pid 600), each a reply subscriber and then a request
+// publisher, ids in the order the library creates them.
+inline FakeSource system_with_service() {
+  FakeSource source = healthy_system();
+  TopicInfo request;
+  request.name = "/_service_request/arm/enable";
+  request.type_name = "std_srvs/srv/SetBool_Request";
+  request.type_hash = 0x1111;
+  TopicInfo reply;
+  reply.name = "/_service_reply/arm/enable";
+  reply.type_name = "std_srvs/srv/SetBool_Response";
+  reply.type_hash = 0x2222;
+  SubscriberInfo server_requests;
+  server_requests.id = 10;
+  server_requests.pid = 400;
+  server_requests.node = "arm_driver";
+  server_requests.depth = 10;
+  server_requests.received = 12;
+  server_requests.dropped = 2;
+  server_requests.uid = 1002;
+  request.subscribers.push_back(server_requests);
+  PublisherInfo server_replies;
+  server_replies.id = 11;
+  server_replies.pid = 400;
+  server_replies.node = "arm_driver";
+  server_replies.depth = 10;
+  server_replies.published = 12;
+  server_replies.uid = 1002;
+  reply.publishers.push_back(server_replies);
+  // {pid, node, reply subscriber id, calls, answers received, answers unreceived}
+  const struct {
+    pid_t pid;
+    const char* node;
+    std::uint32_t id;
+    std::uint64_t calls;
+    std::uint64_t received;
+    std::uint32_t unreceived;
+  } clients[] = {
+      {600, "planner", 16, 1, 0, 0}, {500, "panel", 12, 5, 4, 1}, {600, "planner", 14, 8, 5, 0}};
+  for (const auto& c : clients) {
+    SubscriberInfo answers;
+    answers.id = c.id;
+    answers.pid = c.pid;
+    answers.node = c.node;
+    answers.depth = 10;
+    answers.received = c.received;
+    answers.unreceived = c.unreceived;
+    answers.uid = 1003;
+    reply.subscribers.push_back(answers);
+    PublisherInfo calls;
+    calls.id = c.id + 1;
+    calls.pid = c.pid;
+    calls.node = c.node;
+    calls.depth = 10;
+    calls.published = c.calls;
+    calls.uid = 1003;
+    request.publishers.push_back(calls);
+  }
+  source.topics.push_back(request);
+  source.topics.push_back(reply);
+  // Each callback subscriber's queue: the server's and the clients'.
+  source.queues["/_service_request_arm_enable@10"] = {0, 10};
+  for (const auto& c : clients) {
+    source.queues["/_service_reply_arm_enable@" + std::to_string(c.id)] = {0, 10};
+  }
+  return source;
+}
+
 }  // namespace agnocast::cli

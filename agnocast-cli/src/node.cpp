@@ -1,8 +1,10 @@
-// agnocast-cli node list | info NODE: endpoints grouped by process and node label.
+// agnocast-cli node list | info NODE: endpoints grouped by process and node
+// label; those on the topics that carry a service count as serving or calling it.
 #include <map>
 #include <set>
 #include <utility>
 
+#include "agnocast/naming.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -15,7 +17,19 @@ using Align = Table::Align;
 struct Endpoints {
   std::set<std::string> publishes;
   std::set<std::string> subscribes;
+  std::set<std::string> serves;  // services, from the topics that carry them
+  std::set<std::string> calls;
 };
+
+// Where an endpoint of a node goes: its topic, or the service the topic carries.
+void add_endpoint(Endpoints& endpoints, const std::string& topic, bool publisher) {
+  if (const std::optional<ServiceTopic> carried = service_of_topic(topic)) {
+    (is_server_endpoint(carried->role, publisher) ? endpoints.serves : endpoints.calls)
+        .insert(carried->service);
+    return;
+  }
+  (publisher ? endpoints.publishes : endpoints.subscribes).insert(topic);
+}
 
 }  // namespace
 
@@ -26,10 +40,10 @@ json node_list_json(InspectionSource& source) {
     const std::optional<TopicInfo> info = source.topic_info(summary.name);
     if (!info) continue;  // the topic went away since it was listed
     for (const PublisherInfo& p : info->publishers) {
-      nodes[{p.pid, p.node}].publishes.insert(info->name);
+      add_endpoint(nodes[{p.pid, p.node}], info->name, true);
     }
     for (const SubscriberInfo& s : info->subscribers) {
-      nodes[{s.pid, s.node}].subscribes.insert(info->name);
+      add_endpoint(nodes[{s.pid, s.node}], info->name, false);
     }
   }
   json list = json::array();
@@ -37,45 +51,60 @@ json node_list_json(InspectionSource& source) {
     list.push_back({{"name", key.second},
                     {"pid", key.first},
                     {"publishes", endpoints.publishes},
-                    {"subscribes", endpoints.subscribes}});
+                    {"subscribes", endpoints.subscribes},
+                    {"serves", endpoints.serves},
+                    {"calls", endpoints.calls}});
   }
   return {{"nodes", list}};
 }
 
 json node_info_json(InspectionSource& source, const std::string& node) {
   std::set<pid_t> pids;
-  // topic -> type, per direction; a node publishing a topic from two pids lists it once.
+  // name -> type, per direction; a node using a topic from two pids lists it once.
   std::map<std::string, std::string> publishes;
   std::map<std::string, std::string> subscribes;
+  std::map<std::string, std::string> serves;
+  std::map<std::string, std::string> calls;
+  const auto add = [&](const TopicInfo& topic, bool publisher) {
+    if (const std::optional<ServiceTopic> carried = service_of_topic(topic.name)) {
+      std::string& type =
+          (is_server_endpoint(carried->role, publisher) ? serves : calls)[carried->service];
+      if (type.empty()) type = service_type_of(topic.type_name, carried->role);
+      return;
+    }
+    (publisher ? publishes : subscribes)[topic.name] = topic.type_name;
+  };
   for (const TopicSummary& summary : source.list_topics()) {
     const std::optional<TopicInfo> info = source.topic_info(summary.name);
     if (!info) continue;  // the topic went away since it was listed
     for (const PublisherInfo& p : info->publishers) {
       if (p.node != node) continue;
       pids.insert(p.pid);
-      publishes[info->name] = info->type_name;
+      add(*info, true);
     }
     for (const SubscriberInfo& s : info->subscribers) {
       if (s.node != node) continue;
       pids.insert(s.pid);
-      subscribes[info->name] = info->type_name;
+      add(*info, false);
     }
   }
   if (pids.empty()) {
     throw CliError("no endpoint belongs to node '" + node +
                    "'; `agnocast-cli node list` shows the nodes that exist");
   }
-  const auto endpoints = [](const std::map<std::string, std::string>& topics) {
+  const auto endpoints = [](const std::map<std::string, std::string>& names, const char* kind) {
     json list = json::array();
-    for (const auto& [topic, type] : topics) {
-      list.push_back({{"topic", topic}, {"type", type.empty() ? json(nullptr) : json(type)}});
+    for (const auto& [name, type] : names) {
+      list.push_back({{kind, name}, {"type", type.empty() ? json(nullptr) : json(type)}});
     }
     return list;
   };
   return {{"name", node},
           {"pids", pids},
-          {"publishers", endpoints(publishes)},
-          {"subscribers", endpoints(subscribes)}};
+          {"publishers", endpoints(publishes, "topic")},
+          {"subscribers", endpoints(subscribes, "topic")},
+          {"servers", endpoints(serves, "service")},
+          {"clients", endpoints(calls, "service")}};
 }
 
 std::string node_info_table(const json& value) {
@@ -86,15 +115,25 @@ std::string node_info_table(const json& value) {
                          cell(e.at("topic")), cell(e.at("type"))});
     }
   }
-  return "node " + cell(value.at("name")) + "\npids " + cell(value.at("pids")) + "\n\n" +
-         endpoints.render();
+  std::string text = "node " + cell(value.at("name")) + "\npids " + cell(value.at("pids")) +
+                     "\n\n" + endpoints.render();
+  if (value.at("servers").empty() && value.at("clients").empty()) return text;
+  Table services({{"ROLE"}, {"SERVICE"}, {"TYPE"}});
+  for (const char* role : {"servers", "clients"}) {
+    for (const json& e : value.at(role)) {
+      services.add_row({role == std::string("servers") ? "serves" : "calls", cell(e.at("service")),
+                        cell(e.at("type"))});
+    }
+  }
+  return text + "\n" + services.render();
 }
 
 std::string node_list_table(const json& value) {
-  Table table({{"NAME"}, {"PID", Align::right}, {"PUBLISHES"}, {"SUBSCRIBES"}});
+  Table table(
+      {{"NAME"}, {"PID", Align::right}, {"PUBLISHES"}, {"SUBSCRIBES"}, {"SERVES"}, {"CALLS"}});
   for (const json& n : value.at("nodes")) {
-    table.add_row(
-        {cell(n.at("name")), cell(n.at("pid")), cell(n.at("publishes")), cell(n.at("subscribes"))});
+    table.add_row({cell(n.at("name")), cell(n.at("pid")), cell(n.at("publishes")),
+                   cell(n.at("subscribes")), cell(n.at("serves")), cell(n.at("calls"))});
   }
   return table.render();
 }
@@ -102,11 +141,11 @@ std::string node_list_table(const json& value) {
 void set_node_command(CLI::App& app, Context& context) {
   CLI::App* node = app.add_subcommand("node", "Nodes: the labelled endpoints of each process");
   node->require_subcommand(1);
-  CLI::App* list = node->add_subcommand("list", "Every node with the topics it uses");
+  CLI::App* list = node->add_subcommand("list", "Every node with the topics and services it uses");
   bind_command(*list, context,
                {[&context] { return node_list_json(context.source); }, node_list_table});
   auto name = std::make_shared<std::string>();
-  CLI::App* info = node->add_subcommand("info", "The processes and topics of one node");
+  CLI::App* info = node->add_subcommand("info", "The processes, topics and services of one node");
   info->add_option("NODE", *name, "Node name, e.g. talker")->required();
   bind_command(
       *info, context,

@@ -1,8 +1,14 @@
-// agnocast-cli policy show: the topic access policy the kernel enforces in
-// this IPC namespace (agnocastd/README.md, "access"), with user and group ids shown by name.
+// agnocast-cli policy show: the access policy the kernel enforces in this IPC
+// namespace (agnocastd/README.md, "access"), its rules as agnocastd's config
+// writes them (services rules included), user and group ids shown by name.
+#include <algorithm>
+#include <cctype>
 #include <string>
+#include <variant>
+#include <vector>
 
 #include "agnocast/access_policy.hpp"
+#include "agnocast/service_access.hpp"
 #include "commands.hpp"
 #include "table.hpp"
 
@@ -33,9 +39,9 @@ json principals_json(InspectionSource& source,
   return list;
 }
 
-// A direction's cell: who is listed, "(nobody)" for an empty list, or
+// A right's cell: who is listed, "(nobody)" for an empty list, or
 // "(default)" when the rule leaves it to the default.
-std::string direction_cell(const json& principals) {
+std::string right_cell(const json& principals) {
   if (principals.is_null()) return "(default)";
   if (principals.empty()) return "(nobody)";
   return cell(principals);
@@ -47,10 +53,19 @@ json policy_show_json(InspectionSource& source) {
   const std::optional<AccessPolicy> policy = source.access_policy();
   if (!policy) return {{"policy", nullptr}};
   json rules = json::array();
-  for (const AccessRule& rule : policy->rules) {
-    rules.push_back({{"topics", rule.topics},
-                     {"publish", principals_json(source, rule.publish)},
-                     {"subscribe", principals_json(source, rule.subscribe)}});
+  // As written in agnocastd's config: the pair of topic rules a services rule
+  // stands for shows as that services rule.
+  for (const WrittenAccessRule& written : written_access_rules(policy->rules)) {
+    if (const auto* rule = std::get_if<AccessRule>(&written)) {
+      rules.push_back({{"topics", rule->topics},
+                       {"publish", principals_json(source, rule->publish)},
+                       {"subscribe", principals_json(source, rule->subscribe)}});
+    } else {
+      const auto& service = std::get<ServiceAccessRule>(written);
+      rules.push_back({{"services", service.services},
+                       {"serve", principals_json(source, service.serve)},
+                       {"call", principals_json(source, service.call)}});
+    }
   }
   return {{"policy", {{"default", policy->default_allow ? "allow" : "deny"}, {"rules", rules}}}};
 }
@@ -61,21 +76,42 @@ std::string policy_show_table(const json& value) {
     return std::string(no_access_policy_meaning) + "\n";
   }
   std::string text = "default: " + policy.at("default").get<std::string>() +
-                     " (topics no rule matches, and directions a rule leaves open)\n";
-  if (policy.at("rules").empty()) return text + "no rules\n";
-  Table table({{"TOPICS"}, {"PUBLISH"}, {"SUBSCRIBE"}});
-  for (const json& rule : policy.at("rules")) {
-    table.add_row({cell(rule.at("topics")), direction_cell(rule.at("publish")),
-                   direction_cell(rule.at("subscribe"))});
+                     " (what no rule matches, and rights a rule leaves open)\n";
+  const json& rules = policy.at("rules");
+  if (rules.empty()) return text + "no rules\n";
+  // A column per right that some rule has; a rule's other rights stay blank.
+  std::vector<std::string> rights;
+  for (const char* right : {"publish", "subscribe", "serve", "call"}) {
+    if (std::any_of(rules.begin(), rules.end(), [&](const json& r) { return r.contains(right); })) {
+      rights.push_back(right);
+    }
+  }
+  std::vector<Table::Column> columns{{"RULE"}};
+  for (std::string header : rights) {
+    for (char& c : header) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    columns.push_back({header});
+  }
+  Table table(columns);
+  for (const json& rule : rules) {
+    const bool topics = rule.contains("topics");
+    std::vector<std::string> row{topics ? "topics " + cell(rule.at("topics"))
+                                        : "services " + cell(rule.at("services"))};
+    for (const std::string& right : rights) {
+      row.push_back(rule.contains(right) ? right_cell(rule.at(right)) : "");
+    }
+    table.add_row(row);
   }
   return text + table.render();
 }
 
 void set_policy_command(CLI::App& app, Context& context) {
-  CLI::App* policy = app.add_subcommand("policy", "The topic access policy (agnocastd's access)");
+  CLI::App* policy =
+      app.add_subcommand("policy", "The access policy on topics and services (agnocastd's access)");
   policy->require_subcommand(1);
   CLI::App* show = policy->add_subcommand(
-      "show", "Who may publish and subscribe which topics; the first matching rule decides");
+      "show",
+      "Who may publish and subscribe which topics, serve and call which services; the first "
+      "matching rule decides");
   bind_command(*show, context,
                {[&context] { return policy_show_json(context.source); }, policy_show_table});
 }

@@ -1,5 +1,6 @@
-// agnocast-cli queue list: every agnocast-pattern notification queue, its
-// depth read with mq_getattr, and whether a live subscriber still owns it.
+// agnocast-cli queue list: every agnocast-pattern notification queue but
+// those of services, its depth read with mq_getattr, and whether a live
+// subscriber still owns it.
 #include <algorithm>
 #include <map>
 #include <utility>
@@ -48,6 +49,8 @@ json queue_list_json(InspectionSource& source) {
     const std::string name = "/" + file;
     const auto owner = owners.find(name);
     const bool stale = owner == owners.end();
+    // A service's queues belong to its server and clients (`service info`).
+    if (!stale && is_service_topic(owner->second.topic)) continue;
     const auto attributes = source.queue_attributes(name);
     queues.push_back({{"name", name},
                       {"topic", stale ? json(nullptr) : json(owner->second.topic)},

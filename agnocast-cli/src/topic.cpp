@@ -51,6 +51,7 @@ json topic_list_json(InspectionSource& source) {
             [](const auto& a, const auto& b) { return a.name < b.name; });
   json list = json::array();
   for (const TopicSummary& topic : topics) {
+    if (is_service_topic(topic.name)) continue;  // `service list` shows those
     list.push_back({{"name", topic.name},
                     {"type", type_of(topic.type_name)},
                     {"publishers", topic.publishers},

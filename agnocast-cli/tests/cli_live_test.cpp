@@ -345,18 +345,22 @@ TEST_F(CliLive, NodeListGroupsByProcess) {
   EXPECT_EQ(find_by(nodes, "pid", talker), json({{"name", "talker"},
                                                  {"pid", talker},
                                                  {"publishes", {topic}},
-                                                 {"subscribes", json::array()}}));
+                                                 {"subscribes", json::array()},
+                                                 {"serves", json::array()},
+                                                 {"calls", json::array()}}));
   EXPECT_EQ(find_by(nodes, "pid", stopped), json({{"name", "stopped"},
                                                   {"pid", stopped},
                                                   {"publishes", json::array()},
-                                                  {"subscribes", {topic}}}));
+                                                  {"subscribes", {topic}},
+                                                  {"serves", json::array()},
+                                                  {"calls", json::array()}}));
 
   const Outcome table = cli("node list");
   ASSERT_EQ(table.code, 0);
   EXPECT_EQ(row_starting(table.out, "talker"),
-            (std::vector<std::string>{"talker", std::to_string(talker), topic, "-"}));
+            (std::vector<std::string>{"talker", std::to_string(talker), topic, "-", "-", "-"}));
   EXPECT_EQ(row_starting(table.out, "listener"),
-            (std::vector<std::string>{"listener", std::to_string(listener), "-", topic}));
+            (std::vector<std::string>{"listener", std::to_string(listener), "-", topic, "-", "-"}));
 }
 
 TEST_F(CliLive, AnUnprivilegedUserInspectsWhatItMayOpen) {
@@ -461,6 +465,10 @@ TEST_F(CliLive, ExitCodes) {
   const Outcome json_missing = cli("topic info /nope --json");
   EXPECT_EQ(json_missing.code, 1);
   EXPECT_EQ(json_missing.value()["exit_code"], 1);
+  // No service runs here: an empty list, and none to show.
+  EXPECT_EQ(cli("service list --json").value(), json::parse(R"({"services":[]})"));
+  EXPECT_EQ(cli("service info /nope").code, 1);
+  EXPECT_EQ(cli("service type bad-name").code, 2);
 }
 
 // After every test that looks at the stopped listener: resumed, its one

@@ -8,9 +8,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <variant>
 #include <vector>
 
 #include "access_principal.hpp"
+#include "agnocast/limits.hpp"
+#include "agnocast/naming.hpp"
+#include "agnocast/service_access.hpp"
 
 namespace agnocastd {
 namespace {
@@ -103,31 +107,120 @@ std::vector<agnocast::AccessPrincipal> access_principals(const json& value, std:
   return principals;
 }
 
-agnocast::AccessRule access_rule(const json& value, std::string_view key) {
+// A rule as written: on topics (publish, subscribe) or on services (serve, call).
+agnocast::WrittenAccessRule access_rule(const json& value, std::string_view key) {
+  // "services" makes a services rule; a key of the other kind is named as such.
+  const bool on_services = value.is_object() && value.contains("services");
+  const Handler other_kind = [on_services](const json&, std::string_view k) {
+    fail(k, on_services ? "a services rule has \"serve\" and \"call\"; \"topics\", \"publish\" "
+                          "and \"subscribe\" belong to a topics rule"
+                        : "a topics rule has \"publish\" and \"subscribe\"; \"serve\" and "
+                          "\"call\" belong to a services rule");
+  };
+  if (value.is_object() && !on_services && !value.contains("topics")) {
+    fail(key,
+         "a rule needs \"topics\", the topic pattern it covers, or \"services\", the service "
+         "pattern it covers");
+  }
+  if (on_services) {
+    agnocast::ServiceAccessRule rule;
+    read_object(value, key,
+                {
+                    {"services",
+                     [&](const json& v, auto k) {
+                       rule.services = text(v, k);
+                       try {
+                         agnocast::parse_service_pattern(rule.services);
+                       } catch (const std::invalid_argument& error) {
+                         fail(k, error.what());
+                       }
+                     }},
+                    {"serve", [&](const json& v, auto k) { rule.serve = access_principals(v, k); }},
+                    {"call", [&](const json& v, auto k) { rule.call = access_principals(v, k); }},
+                    {"topics", other_kind},
+                    {"publish", other_kind},
+                    {"subscribe", other_kind},
+                });
+    return rule;
+  }
   agnocast::AccessRule rule;
-  bool has_topics = false;
   read_object(
       value, key,
       {
           {"topics",
            [&](const json& v, auto k) {
              rule.topics = text(v, k);
+             bool reserved = false;
              try {
-               agnocast::parse_topic_pattern(rule.topics);
+               reserved =
+                   agnocast::is_service_topic(agnocast::parse_topic_pattern(rule.topics).prefix);
              } catch (const std::invalid_argument& error) {
                fail(k, error.what());
              }
-             has_topics = true;
+             if (reserved) {
+               fail(k, "topics under " + std::string(agnocast::service_request_prefix) + " and " +
+                           std::string(agnocast::service_reply_prefix) +
+                           " carry services: write a services rule, e.g. {\"services\": "
+                           "\"/arm/*\", \"serve\": [..], \"call\": [..]}");
+             }
            }},
           {"publish", [&](const json& v, auto k) { rule.publish = access_principals(v, k); }},
           {"subscribe", [&](const json& v, auto k) { rule.subscribe = access_principals(v, k); }},
+          {"serve", other_kind},
+          {"call", other_kind},
       });
-  if (!has_topics) fail(key, "a rule needs \"topics\", the topic pattern it covers");
   return rule;
+}
+
+// How a rule is named in errors: access.rules[0] (topics "/**").
+std::string rule_name(std::string_view key, const agnocast::WrittenAccessRule& rule) {
+  if (const auto* topics = std::get_if<agnocast::AccessRule>(&rule)) {
+    return std::string(key) + " (topics \"" + topics->topics + "\")";
+  }
+  return std::string(key) + " (services \"" + std::get<agnocast::ServiceAccessRule>(rule).services +
+         "\")";
+}
+
+// The kernel takes the first rule that matches, so a services rule whose
+// topics an earlier rule all matches (a topic rule "/**" above it) would
+// silently never apply: refused, naming the rule that takes its place.
+void check_reachable(const std::vector<agnocast::AccessRule>& earlier,
+                     const std::vector<std::string>& earlier_names,
+                     const agnocast::AccessRule& carrier, std::string_view key) {
+  const agnocast::TopicPattern pattern = agnocast::parse_topic_pattern(carrier.topics);
+  for (std::size_t i = 0; i < earlier.size(); ++i) {
+    if (agnocast::covers(agnocast::parse_topic_pattern(earlier[i].topics), pattern)) {
+      fail(key, "this services rule never applies: " + earlier_names[i] +
+                    " comes first and matches every topic its services use (" + carrier.topics +
+                    "); the first matching rule decides, so put this rule before it");
+    }
+  }
 }
 
 agnocast::AccessPolicy access_policy(const json& value, std::string_view key) {
   agnocast::AccessPolicy policy;
+  // The config rule each kernel rule comes from, for errors.
+  std::vector<std::string> rule_names;
+  const auto add_rules = [&](const json& rules, std::string_view rules_key) {
+    if (!rules.is_array()) fail(rules_key, "expected an array of rules, got " + type_of(rules));
+    for (std::size_t i = 0; i < rules.size(); ++i) {
+      const std::string rule_key = element_key(rules_key, i);
+      const agnocast::WrittenAccessRule rule = access_rule(rules[i], rule_key);
+      const std::string name = rule_name(rule_key, rule);
+      if (const auto* topics = std::get_if<agnocast::AccessRule>(&rule)) {
+        policy.rules.push_back(*topics);
+        rule_names.push_back(name);
+        continue;
+      }
+      // A services rule is two topic rules, in its place.
+      for (const agnocast::AccessRule& carrier :
+           agnocast::topic_rules_of(std::get<agnocast::ServiceAccessRule>(rule))) {
+        check_reachable(policy.rules, rule_names, carrier, rule_key);
+        policy.rules.push_back(carrier);
+        rule_names.push_back(name);
+      }
+    }
+  };
   read_object(value, key,
               {
                   {"default",
@@ -138,14 +231,26 @@ agnocast::AccessPolicy access_policy(const json& value, std::string_view key) {
                      }
                      policy.default_allow = decision == "allow";
                    }},
-                  {"rules",
-                   [&](const json& v, auto k) {
-                     if (!v.is_array()) fail(k, "expected an array of rules, got " + type_of(v));
-                     for (std::size_t i = 0; i < v.size(); ++i) {
-                       policy.rules.push_back(access_rule(v[i], element_key(k, i)));
-                     }
-                   }},
+                  {"rules", add_rules},
               });
+  // What the kernel takes, checked here so that --check-config says it.
+  std::size_t principals = 0;
+  for (const agnocast::AccessRule& rule : policy.rules) {
+    principals += rule.publish.value_or(std::vector<agnocast::AccessPrincipal>{}).size() +
+                  rule.subscribe.value_or(std::vector<agnocast::AccessPrincipal>{}).size();
+  }
+  if (policy.rules.size() > agnocast::access_policy_rules_max) {
+    fail(std::string(key) + ".rules",
+         "the rules make " + std::to_string(policy.rules.size()) +
+             " rules in the kernel (a services rule makes two): at most " +
+             std::to_string(agnocast::access_policy_rules_max));
+  }
+  if (principals > agnocast::access_policy_principals_max) {
+    fail(std::string(key) + ".rules",
+         "the rules name " + std::to_string(principals) +
+             " users and groups in all (a services rule names its own twice): at most " +
+             std::to_string(agnocast::access_policy_principals_max));
+  }
   return policy;
 }
 

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include "agnocast/naming.hpp"
+
 namespace agnocastd {
 namespace {
 
@@ -132,7 +134,8 @@ TEST(ConfigAccess, ErrorsNameTheKeyPath) {
   EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": [0]}]}})"),
             "config key 'access.rules[0].publish[0]': expected a string, got number");
   EXPECT_EQ(error_of(R"({"access": {"rules": [{"publish": []}]}})"),
-            "config key 'access.rules[0]': a rule needs \"topics\", the topic pattern it covers");
+            "config key 'access.rules[0]': a rule needs \"topics\", the topic pattern it covers, "
+            "or \"services\", the service pattern it covers");
   EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "read": []}]}})"),
             "config key 'access.rules[0].read': unknown key");
   EXPECT_EQ(error_of(R"({"access": {"default": "maybe"}})"),
@@ -146,6 +149,126 @@ TEST(ConfigAccess, ErrorsNameTheKeyPath) {
       bad_pattern.rfind("config key 'access.rules[0].topics': access rule topics '/a/**/b'", 0), 0u)
       << bad_pattern;
   EXPECT_NE(error_of(R"({"access": {"rules": [{"topics": "safety/**"}]}})"), "");
+}
+
+TEST(ConfigAccess, ServicesRulesBecomeTwoTopicRulesInPlace) {
+  using agnocast::AccessPrincipal;
+  using agnocast::AccessRule;
+  using Kind = AccessPrincipal::Kind;
+  using Principals = std::vector<AccessPrincipal>;
+  const Config config = parse_config(R"({"access": {"default": "deny", "rules": [
+      {"topics": "/chatter", "publish": ["*"]},
+      {"services": "/arm/*", "serve": ["user:10"], "call": ["group:20", "user:0"]},
+      {"services": "/**", "call": []},
+      {"topics": "/**", "subscribe": ["group:0"]}]}})");
+  ASSERT_TRUE(config.access);
+  const Principals anyone{{Kind::anyone, 0}};
+  const Principals servers{{Kind::user, 10}};
+  const Principals callers{{Kind::group, 20}, {Kind::user, 0}};
+  EXPECT_EQ(config.access->rules, (std::vector<AccessRule>{
+                                      {"/chatter", anyone, std::nullopt},
+                                      {"/_service_request/arm/*", callers, servers},
+                                      {"/_service_reply/arm/*", servers, callers},
+                                      {"/_service_request/**", Principals{}, std::nullopt},
+                                      {"/_service_reply/**", std::nullopt, Principals{}},
+                                      {"/**", std::nullopt, Principals{{Kind::group, 0}}},
+                                  }));
+}
+
+TEST(ConfigAccess, ServicesRuleErrorsNameTheKeyPath) {
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "services": "/a"}]}})"),
+            "config key 'access.rules[0].topics': a services rule has \"serve\" and \"call\"; "
+            "\"topics\", \"publish\" and \"subscribe\" belong to a topics rule");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"services": "/a", "publish": []}]}})"),
+            "config key 'access.rules[0].publish': a services rule has \"serve\" and "
+            "\"call\"; \"topics\", \"publish\" and \"subscribe\" belong to a topics rule");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "call": []}]}})"),
+            "config key 'access.rules[0].call': a topics rule has \"publish\" and "
+            "\"subscribe\"; \"serve\" and \"call\" belong to a services rule");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"serve": []}]}})"),
+            "config key 'access.rules[0]': a rule needs \"topics\", the topic pattern it "
+            "covers, or \"services\", the service pattern it covers");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"services": "/a", "serve": ["root"]}]}})"),
+            "config key 'access.rules[0].serve[0]': expected \"user:NAME\", \"group:NAME\" "
+            "(or a numeric id) or \"*\", got \"root\"");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"services": "/a", "call": "*"}]}})"),
+            "config key 'access.rules[0].call': expected an array of \"user:NAME\", "
+            "\"group:NAME\" or \"*\", got string");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"services": 7}]}})"),
+            "config key 'access.rules[0].services': expected a string, got number");
+  for (const char* pattern : {"arm/*", "/a/**/b", "/", "", "/a b", "/_service_request/x"}) {
+    const std::string error =
+        error_of(R"({"access": {"rules": [{"services": ")" + std::string(pattern) + R"("}]}})");
+    EXPECT_EQ(error.rfind("config key 'access.rules[0].services': access rule services '" +
+                              std::string(pattern) + "': ",
+                          0),
+              0u)
+        << error;
+  }
+  const std::string too_long = "/" + std::string(agnocast::service_name_max, 'a');
+  EXPECT_NE(
+      error_of(R"({"access": {"rules": [{"services": ")" + too_long + R"("}]}})").find("too long"),
+      std::string::npos);
+}
+
+TEST(ConfigAccess, TopicRulesMayNotNameTheTopicsThatCarryServices) {
+  for (const char* pattern : {"/_service_request/**", "/_service_reply/arm/enable",
+                              "/_service_request", "/_service_reply/*"}) {
+    EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": ")" + std::string(pattern) +
+                       R"(", "publish": []}]}})"),
+              "config key 'access.rules[0].topics': topics under /_service_request and "
+              "/_service_reply carry services: write a services rule, e.g. {\"services\": "
+              "\"/arm/*\", \"serve\": [..], \"call\": [..]}")
+        << pattern;
+  }
+  // Names that only look alike are ordinary topics.
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/_service_requests/**"}]}})"), "");
+}
+
+TEST(ConfigAccess, TheKernelsLimitsCountTheTopicRulesServicesRulesMake) {
+  const auto rules = [](std::size_t topics, std::size_t services, const std::string& who) {
+    std::string text = R"({"access": {"rules": [)";
+    for (std::size_t i = 0; i < topics + services; ++i) {
+      if (i > 0) text += ",";
+      text += i < topics ? R"({"topics": "/t)" + std::to_string(i) + R"(", "publish": )" + who + "}"
+                         : R"({"services": "/s)" + std::to_string(i) + R"(", "call": )" + who + "}";
+    }
+    return text + "]}}";
+  };
+  EXPECT_EQ(error_of(rules(254, 1, "[]")), "");
+  EXPECT_EQ(error_of(rules(128, 65, "[]")),
+            "config key 'access.rules': the rules make 258 rules in the kernel (a services rule "
+            "makes two): at most 256");
+  std::string many = "[";
+  for (int i = 0; i < 32; ++i)
+    many += std::string(i > 0 ? "," : "") + "\"user:" + std::to_string(i) + "\"";
+  many += "]";
+  EXPECT_EQ(error_of(rules(128, 0, many)), "");  // 4096 users and groups
+  EXPECT_EQ(error_of(rules(127, 1, many)),
+            "config key 'access.rules': the rules name 4128 users and groups in all (a services "
+            "rule names its own twice): at most 4096");
+}
+
+TEST(ConfigAccess, AServicesRuleAnEarlierRuleHidesIsRefusedNamingThatRule) {
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/**", "publish": ["*"]},
+                                                {"services": "/arm/*", "serve": []}]}})"),
+            "config key 'access.rules[1]': this services rule never applies: access.rules[0] "
+            "(topics \"/**\") comes first and matches every topic its services use "
+            "(/_service_request/arm/*); the first matching rule decides, so put this rule "
+            "before it");
+  EXPECT_NE(error_of(R"({"access": {"rules": [{"services": "/arm/**"}, {"topics": "/a"},
+                                                {"services": "/arm/enable"}]}})")
+                .find("'access.rules[2]': this services rule never applies: access.rules[0] "
+                      "(services \"/arm/**\")"),
+            std::string::npos);
+  // Narrower first, or the topic rule "/**" last: every rule can apply.
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"services": "/arm/enable"},
+                                                {"services": "/arm/**"},
+                                                {"topics": "/arm/**"},
+                                                {"services": "/**"},
+                                                {"topics": "/**"}]}})"),
+            "");
+  EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/*"}, {"services": "/*"}]}})"), "");
 }
 
 TEST(Config, MissingFileIsDefaultOnlyForTheDefaultPath) {

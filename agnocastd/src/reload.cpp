@@ -4,8 +4,10 @@
 
 #include <exception>
 #include <map>
+#include <variant>
 
 #include "agnocast/access_policy.hpp"
+#include "agnocast/service_access.hpp"
 #include "module_loader.hpp"
 #include "mqueue_setup.hpp"
 
@@ -42,7 +44,14 @@ void differences_in_parameters(const std::map<std::string, std::string>& in_forc
 void apply_access_policy(const std::optional<agnocast::AccessPolicy>& policy) {
   agnocast::set_access_policy(policy);
   if (policy) {
-    spdlog::info("topic access policy in force: {} rule(s), default {}", policy->rules.size(),
+    // Counted as the config writes them: a services rule is two rules in the kernel.
+    std::size_t service_rules = 0;
+    const auto written = agnocast::written_access_rules(policy->rules);
+    for (const agnocast::WrittenAccessRule& rule : written) {
+      service_rules += std::holds_alternative<agnocast::ServiceAccessRule>(rule) ? 1 : 0;
+    }
+    spdlog::info("access policy in force: {} topics rule(s), {} services rule(s), default {}",
+                 written.size() - service_rules, service_rules,
                  policy->default_allow ? "allow" : "deny");
   } else {
     spdlog::info("{}", agnocast::no_access_policy_meaning);

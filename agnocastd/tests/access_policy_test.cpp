@@ -125,7 +125,8 @@ const char* policy_a = R"({"device": {"group": "agnocast"}, "sweep_interval_s": 
     {"topics": "/safety/**", "publish": ["group:3000"], "subscribe": ["group:agnocast"]}]}})";
 const char* policy_b = R"({"device": {"group": "agnocast"}, "sweep_interval_s": 1,
   "access": {"default": "deny", "rules": [
-    {"topics": "/safety/**", "publish": ["user:2002"], "subscribe": ["*"]}]}})";
+    {"topics": "/safety/**", "publish": ["user:2002"], "subscribe": ["*"]},
+    {"services": "/arm/*", "serve": ["user:2002"], "call": ["*"]}]}})";
 const char* bad_policy = R"({"device": {"group": "agnocast"},
   "access": {"rules": [{"topics": "/safety/**", "publish": ["group:no_such_group_zz"]}]}})";
 
@@ -166,8 +167,12 @@ TEST(AccessPolicy, EnforcedShownAndReplacedOnSighup) {
   ASSERT_TRUE(eventually([] { return log_has("configuration reloaded"); }, patience))
       << slurp("agnocastd.log");
   const std::uint64_t published_at_reload = published();
+  // The services rule went into the kernel as two topic rules and shows as written.
   EXPECT_EQ(policy_shown(&outsider), json::parse(R"({"policy": {"default": "deny", "rules": [
-    {"topics": "/safety/**", "publish": ["user:2002"], "subscribe": ["*"]}]}})"));
+    {"topics": "/safety/**", "publish": ["user:2002"], "subscribe": ["*"]},
+    {"services": "/arm/*", "serve": ["user:2002"], "call": ["*"]}]}})"));
+  EXPECT_TRUE(log_has("access policy in force: 1 topics rule(s), 1 services rule(s), default deny"))
+      << slurp("agnocastd.log");
   EXPECT_EQ(try_endpoint(safety_member, Direction::publish, "/safety/brake", &why), denied) << why;
   EXPECT_EQ(try_endpoint(outsider, Direction::publish, "/safety/brake", &why), created) << why;
   EXPECT_EQ(try_endpoint(safety_member, Direction::subscribe, "/safety/brake"), created);

@@ -49,6 +49,19 @@ bool matches(const TopicPattern& pattern, std::string_view topic) {
          topic.find('/') == std::string_view::npos;
 }
 
+bool covers(const TopicPattern& outer, const TopicPattern& inner) {
+  if (inner.match == TopicPattern::Match::exact) return matches(outer, inner.prefix);
+  switch (outer.match) {
+    case TopicPattern::Match::children:
+      return inner.match == TopicPattern::Match::children && inner.prefix == outer.prefix;
+    case TopicPattern::Match::descendants:
+      return inner.prefix == outer.prefix || matches(outer, inner.prefix);
+    case TopicPattern::Match::exact:
+      break;
+  }
+  return false;  // inner matches more than one topic
+}
+
 std::optional<AccessPolicy> access_policy() { return detail::Device::open().get_policy(); }
 
 void set_access_policy(const std::optional<AccessPolicy>& policy) {

@@ -76,5 +76,31 @@ TEST(TopicPattern, DescendantsMatchAnyDepthBelowButNotThePrefix) {
   EXPECT_TRUE(matches(everything, "/a/b/c"));
 }
 
+TEST(TopicPattern, CoversWhatItMatchesAll) {
+  const auto covers_text = [](const char* outer, const char* inner) {
+    return covers(parse_topic_pattern(outer), parse_topic_pattern(inner));
+  };
+  for (const char* inner : {"/a", "/a/b/c", "/*", "/**", "/a/*", "/a/**"}) {
+    EXPECT_TRUE(covers_text("/**", inner)) << inner;
+    EXPECT_TRUE(covers_text(inner, inner)) << inner;
+  }
+  EXPECT_TRUE(covers_text("/a/**", "/a/b"));
+  EXPECT_TRUE(covers_text("/a/**", "/a/b/*"));
+  EXPECT_TRUE(covers_text("/a/**", "/a/b/**"));
+  EXPECT_TRUE(covers_text("/a/**", "/a/*"));
+  EXPECT_TRUE(covers_text("/a/*", "/a/b"));
+  EXPECT_TRUE(covers_text("/*", "/a"));
+  EXPECT_FALSE(covers_text("/a/**", "/a"));
+  EXPECT_FALSE(covers_text("/a/**", "/ab/*"));
+  EXPECT_FALSE(covers_text("/a/**", "/**"));
+  EXPECT_FALSE(covers_text("/a/*", "/a/**"));
+  EXPECT_FALSE(covers_text("/a/*", "/a/b/c"));
+  EXPECT_FALSE(covers_text("/a/*", "/a/b/*"));
+  EXPECT_FALSE(covers_text("/*", "/a/*"));
+  EXPECT_FALSE(covers_text("/*", "/**"));
+  EXPECT_FALSE(covers_text("/a", "/a/*"));
+  EXPECT_FALSE(covers_text("/a", "/b"));
+}
+
 }  // namespace
 }  // namespace agnocast

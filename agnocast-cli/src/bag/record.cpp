@@ -32,6 +32,7 @@
 #include "agnocast/version.hpp"
 #include "bag/bag.hpp"
 #include "bag/qos_profiles.hpp"
+#include "commands.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -102,6 +103,9 @@ class Recorder {
 
   // A topic named on the command line: it must exist and carry a schema.
   void add_named(const std::string& topic) {
+    if (const std::string refusal = service_topic_refusal(topic); !refusal.empty()) {
+      throw InputError("cannot record: " + refusal);
+    }
     const std::optional<TopicInfo> info = topic_info(topic);
     if (!info) {
       throw InputError("topic '" + topic +

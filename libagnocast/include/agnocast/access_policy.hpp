@@ -54,6 +54,9 @@ TopicPattern parse_topic_pattern(std::string_view pattern);
 std::string to_string(const TopicPattern& pattern);
 // Whether a topic matches, with the kernel's semantics (for tools and tests).
 bool matches(const TopicPattern& pattern, std::string_view topic);
+// Whether `outer` matches every topic `inner` matches: a rule of pattern
+// `inner` after one of pattern `outer` never decides anything.
+bool covers(const TopicPattern& outer, const TopicPattern& inner);
 
 // What having no policy means, as the daemon logs it and the CLI shows it.
 inline constexpr std::string_view no_access_policy_meaning =

@@ -44,4 +44,9 @@ inline constexpr std::size_t message_max_nesting = 32;
 inline constexpr std::size_t publishers_per_topic_max = 1024;
 inline constexpr std::size_t subscribers_per_topic_max = 1024;
 
+// An access policy's rules, and the users and groups all its rules name
+// together (AGNOCAST_POLICY_RULES_MAX, AGNOCAST_POLICY_PRINCIPALS_MAX).
+inline constexpr std::size_t access_policy_rules_max = 256;
+inline constexpr std::size_t access_policy_principals_max = 4096;
+
 }  // namespace agnocast

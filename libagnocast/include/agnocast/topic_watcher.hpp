@@ -12,8 +12,8 @@
 //
 // A topic is present while it has a message type with a schema (not "raw:")
 // and more endpoints than the caller's own (own_endpoints), or a publisher
-// when publishers_only. One that changes type is gone and appears again in
-// the same poll. One whose schema cannot be used is refused once per type.
+// when publishers_only; the topics that carry services never are. One that changes type is gone and
+// appears again in the same poll. One whose schema cannot be used is refused once per type.
 #pragma once
 
 #include <cstdint>

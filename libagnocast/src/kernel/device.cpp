@@ -56,6 +56,8 @@ static_assert(AGNOCAST_SCHEMA_MAX == schema_max_bytes);
 static_assert(AGNOCAST_PUBLISHERS_PER_TOPIC_MAX == publishers_per_topic_max);
 static_assert(AGNOCAST_SUBSCRIBERS_PER_TOPIC_MAX == subscribers_per_topic_max);
 static_assert(Kernel::receive_entries_max == AGNOCAST_RECEIVE_BATCH);
+static_assert(AGNOCAST_POLICY_RULES_MAX == access_policy_rules_max);
+static_assert(AGNOCAST_POLICY_PRINCIPALS_MAX == access_policy_principals_max);
 
 std::string errno_advice(int err) {
   switch (err) {

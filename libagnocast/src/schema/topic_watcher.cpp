@@ -2,10 +2,13 @@
 
 #include <utility>
 
+#include "agnocast/naming.hpp"
+
 namespace agnocast {
 
 bool TopicWatcher::counts(const TopicSummary& topic) const {
   if (topic.type_name.empty() || topic.type_name.starts_with("raw:")) return false;
+  if (is_service_topic(topic.name)) return false;  // no application may subscribe there
   if (options_.wanted && !options_.wanted(topic.name)) return false;
   if (options_.publishers_only) return topic.publishers > 0;
   const std::uint32_t own = options_.own_endpoints ? options_.own_endpoints(topic.name) : 0;

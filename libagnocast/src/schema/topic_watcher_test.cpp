@@ -140,5 +140,16 @@ TEST(TopicWatcher, UsesTheTypesOwnTextAndRefusesWhatHasNoDefinitionOnce) {
   EXPECT_EQ(resolved, before);
 }
 
+TEST(TopicWatcher, LeavesOutTheTopicsThatCarryServices) {
+  Topics topics;
+  topics.add<Reading>("/_service_request/calibrate", 1, 1);
+  topics.add<Sample>("/_service_reply/calibrate", 1, 1);
+  topics.add<Reading>("/_service_requests", 1, 0);  // an ordinary topic
+  TopicWatcher watcher(topics.options());
+  const TopicChanges changes = watcher.poll();
+  EXPECT_EQ(names(changes.appeared), std::vector<std::string>{"/_service_requests"});
+  EXPECT_TRUE(changes.refused.empty());
+}
+
 }  // namespace
 }  // namespace agnocast

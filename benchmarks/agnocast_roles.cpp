@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <sensor_msgs/msg/point_cloud2.hpp>
 #include <span>
@@ -19,6 +20,7 @@
 #include <thread>
 
 #include "allocation_counter.hpp"
+#include "bench_service.hpp"
 #include "bench_support.hpp"
 #include "syscall_counter.hpp"
 #include "window_counters.hpp"
@@ -204,6 +206,196 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
   munmap(shared, sizeof(std::atomic<std::uint32_t>));
   return per_subscriber;
+}
+
+namespace {
+
+// A reply written before the first request, one per request: what a
+// publisher's payload is before publish(), outside the measured window.
+template <typename Message, typename Borrow>
+std::vector<agnocast::ipc_shared_ptr<Message>> written_replies(std::size_t size, std::size_t count,
+                                                               Borrow borrow) {
+  std::vector<agnocast::ipc_shared_ptr<Message>> replies;
+  for (std::size_t seq = 0; seq < count; ++seq) {
+    auto reply = borrow();
+    reply->seq = seq;
+    reply->payload.resize(size);
+    fill_payload(std::span(reply->payload.data(), size), seq);
+    replies.push_back(std::move(reply));
+  }
+  return replies;
+}
+
+// The answer to the request of sequence `seq`, whole and in place.
+bool reply_intact(const BenchResponse& reply, std::uint64_t seq, std::size_t size) {
+  return reply.seq == seq && reply.payload.size() == size &&
+         payload_intact(std::span(reply.payload.data(), size), seq);
+}
+
+// The asking side of a round trip: before each sample it pauses, writes the
+// request and the scratch, then `send(seq, answered)` starts the request
+// (after t0) and the executor runs until the answer's callback has called
+// answered(t1, reply).  Returns the round trips, warm-up removed.
+template <typename Send>
+std::vector<std::int64_t> ask_and_time(agnocast::Executor& executor, std::size_t size,
+                                       std::size_t total, std::size_t scratch_bytes, Send send) {
+  SharedScratch scratch(scratch_bytes);
+  std::vector<std::int64_t> round_trips;
+  for (std::size_t seq = 0; seq < total; ++seq) {
+    settle_between_messages();
+    std::int64_t t1 = 0;
+    bool answered = false, intact = false;
+    auto on_answer = [&](std::int64_t at, const BenchResponse* reply) {
+      t1 = at;
+      intact = reply && reply_intact(*reply, seq, size);
+      answered = true;
+    };
+    fill_payload(scratch.bytes(), seq);
+    const std::int64_t t0 = send(seq, on_answer);
+    while (!answered) {
+      if (!executor.spin_once(std::chrono::seconds(60))) {
+        throw std::runtime_error("a round trip got no answer");
+      }
+    }
+    if (!intact) throw std::runtime_error("a round trip's answer arrived wrong");
+    if (seq >= warmup_messages) round_trips.push_back(t1 - t0);
+  }
+  return round_trips;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> run_agnocast_round_trip(std::size_t size, std::size_t count,
+                                                  std::size_t scratch_bytes) {
+  const std::string name = next_topic("service");
+  const std::size_t total = warmup_messages + count;
+  Pipe ready = Pipe::open(), stop = Pipe::open(), results = Pipe::open();
+  const pid_t server = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_server"};
+    std::vector<agnocast::ipc_shared_ptr<BenchResponse>> responses;
+    std::size_t answered = 0;
+    auto service = node.create_service<BenchService>(
+        name, [&](std::shared_ptr<agnocast::Service<BenchService>> serving, agnocast::RequestId id,
+                  agnocast::ipc_shared_ptr<const BenchRequest> request) {
+          auto response = std::move(responses.at(answered));
+          // What it was asked: the client finds a wrong sequence number.
+          if (request->seq != answered || request->payload.size() != size) response->seq = ~0ULL;
+          ++answered;
+          serving->send_response(id, std::move(response));
+        });
+    responses = written_replies<BenchResponse>(size, total,
+                                               [&] { return service->borrow_loaned_response(); });
+    // Stopped by the client once it has every answer, not from a callback
+    // inside the last sample's window.
+    executor.add_fd(stop.read_fd, [&] { executor.cancel(); });
+    executor.add_node(node);
+    char byte = 1;
+    write_all(ready.write_fd, &byte, 1);
+    executor.spin();
+    return answered == total ? 0 : 1;
+  });
+  const pid_t client = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_client"};
+    auto caller = node.create_client<BenchService>(name);
+    read_bytes(ready.read_fd, 1);
+    if (!caller->wait_for_service(std::chrono::seconds(60))) {
+      throw std::runtime_error("the benchmark's server did not come");
+    }
+    executor.add_node(node);
+    using Future = agnocast::Client<BenchService>::SharedFuture;
+    auto round_trips =
+        ask_and_time(executor, size, total, scratch_bytes, [&](std::size_t seq, auto& on_answer) {
+          auto request = caller->borrow_loaned_request();
+          request->seq = seq;
+          request->payload.resize(size);
+          fill_payload(std::span(request->payload.data(), size), seq);
+          const std::int64_t t0 = now_ns();
+          caller->async_send_request(std::move(request), [&on_answer](Future future) {
+            const std::int64_t t1 = now_ns();
+            try {
+              on_answer(t1, future.get().get());
+            } catch (const std::exception&) {
+              on_answer(t1, nullptr);
+            }
+          });
+          return t0;
+        });
+    char byte = 1;
+    write_all(stop.write_fd, &byte, 1);
+    send_latencies(results.write_fd, round_trips);
+    return 0;
+  });
+  results.close_write();
+  std::vector<std::int64_t> round_trips = receive_latencies(results.read_fd);
+  results.close_read();
+  reap(client, "client");
+  reap(server, "server");
+  if (round_trips.size() != count) throw std::runtime_error("the client missed answers");
+  return round_trips;
+}
+
+std::vector<std::int64_t> run_agnocast_ping_pong(std::size_t size, std::size_t count) {
+  const std::string ping_topic = next_topic("ping"), pong_topic = ping_topic + "_pong";
+  const std::size_t total = warmup_messages + count;
+  Pipe ready = Pipe::open(), stop = Pipe::open(), results = Pipe::open();
+  const pid_t echo = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_echo"};
+    auto pong = node.create_publisher<BenchResponse>(pong_topic, agnocast::QoS{1});
+    auto pongs =
+        written_replies<BenchResponse>(size, total, [&] { return pong->borrow_loaned_message(); });
+    std::size_t answered = 0;
+    auto ping = node.create_subscription<BenchRequest>(
+        ping_topic, agnocast::QoS{10}, [&](const agnocast::ipc_shared_ptr<const BenchRequest>& m) {
+          auto reply = std::move(pongs.at(answered));
+          if (m->seq != answered || m->payload.size() != size) reply->seq = ~0ULL;
+          ++answered;
+          pong->publish(std::move(reply));
+        });
+    executor.add_fd(stop.read_fd, [&] { executor.cancel(); });
+    executor.add_node(node);
+    char byte = 1;
+    write_all(ready.write_fd, &byte, 1);
+    executor.spin();
+    return answered == total ? 0 : 1;
+  });
+  const pid_t asker = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_asker"};
+    auto ping = node.create_publisher<BenchRequest>(ping_topic, agnocast::QoS{1});
+    std::function<void(std::int64_t, const BenchResponse*)> on_pong;
+    auto pong = node.create_subscription<BenchResponse>(
+        pong_topic, agnocast::QoS{10}, [&](const agnocast::ipc_shared_ptr<const BenchResponse>& m) {
+          const std::int64_t t1 = now_ns();
+          on_pong(t1, m.get());
+        });
+    read_bytes(ready.read_fd, 1);
+    executor.add_node(node);
+    auto round_trips =
+        ask_and_time(executor, size, total, 0, [&](std::size_t seq, auto& on_answer) {
+          on_pong = on_answer;
+          auto message = ping->borrow_loaned_message();
+          message->seq = seq;
+          message->payload.resize(size);
+          fill_payload(std::span(message->payload.data(), size), seq);
+          const std::int64_t t0 = now_ns();
+          ping->publish(std::move(message));
+          return t0;
+        });
+    char byte = 1;
+    write_all(stop.write_fd, &byte, 1);
+    send_latencies(results.write_fd, round_trips);
+    return 0;
+  });
+  results.close_write();
+  std::vector<std::int64_t> round_trips = receive_latencies(results.read_fd);
+  results.close_read();
+  reap(asker, "ping-pong's asker");
+  reap(echo, "ping-pong's echo");
+  if (round_trips.size() != count) throw std::runtime_error("the ping-pong missed answers");
+  return round_trips;
 }
 
 std::vector<std::int64_t> run_python_latency(const PythonSubscriber& python, std::size_t size,

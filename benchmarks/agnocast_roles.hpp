@@ -26,6 +26,21 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
                                                             std::size_t subscribers,
                                                             std::size_t scratch_bytes = 0);
 
+// Request to response: `count` round trips of a service whose request and
+// response each carry `size` payload bytes, from async_send_request() (the
+// request written) to the first line of the client's response callback, one
+// request in flight, both sides asleep before each.  The server answers from
+// its callback with a response it wrote before the first request came; the
+// client writes scratch_bytes of shared memory before each request (as
+// run_agnocast_latency), so that every size can write as many bytes.
+std::vector<std::int64_t> run_agnocast_round_trip(std::size_t size, std::size_t count,
+                                                  std::size_t scratch_bytes);
+
+// The same window over two one-way publishes of `size` payload bytes: a
+// ping on one topic, whose callback publishes a pong written beforehand on a
+// second topic, to the first line of the pong's callback.
+std::vector<std::int64_t> run_agnocast_ping_pong(std::size_t size, std::size_t count);
+
 // How to start the Python subscriber (python_subscriber.py): the interpreter,
 // the script and the folder holding the agnocast package (PYTHONPATH).
 struct PythonSubscriber {

@@ -246,6 +246,59 @@ std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t cou
   return latencies;
 }
 
+std::vector<std::int64_t> run_unix_socket_request_response(std::size_t count) {
+  int fds[2];
+  if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds) != 0) {
+    throw std::system_error(errno, std::generic_category(), "socketpair");
+  }
+  // Sleeps in epoll_wait until fd is readable, then reads its one byte;
+  // false at the peer's end.
+  auto wait_and_read = [](int epoll_fd, int fd) {
+    epoll_event event{};
+    while (epoll_wait(epoll_fd, &event, 1, -1) != 1) {
+      if (errno != EINTR) return false;
+    }
+    char byte = 0;
+    return ::read(fd, &byte, 1) == 1;
+  };
+  auto epoll_on = [](int fd) {
+    const int epoll_fd = epoll_create1(EPOLL_CLOEXEC);
+    epoll_event event{};
+    event.events = EPOLLIN;
+    if (epoll_fd < 0 || epoll_ctl(epoll_fd, EPOLL_CTL_ADD, fd, &event) != 0) {
+      throw std::system_error(errno, std::generic_category(), "epoll for the socket floor");
+    }
+    return epoll_fd;
+  };
+  const pid_t server = fork();
+  if (server < 0) throw std::system_error(errno, std::generic_category(), "fork");
+  if (server == 0) {
+    ::close(fds[0]);
+    const int epoll_fd = epoll_on(fds[1]);
+    const char answer = 2;
+    while (wait_and_read(epoll_fd, fds[1])) {
+      if (::write(fds[1], &answer, 1) != 1) _exit(1);
+    }
+    _exit(0);
+  }
+  ::close(fds[1]);
+  const int epoll_fd = epoll_on(fds[0]);
+  std::vector<std::int64_t> round_trips;
+  const char request = 1;
+  for (std::size_t i = 0; i < count; ++i) {
+    settle_between_messages();
+    const std::int64_t t0 = now_ns();
+    if (::write(fds[0], &request, 1) != 1 || !wait_and_read(epoll_fd, fds[0])) {
+      throw std::system_error(errno, std::generic_category(), "socket request/response");
+    }
+    round_trips.push_back(now_ns() - t0);
+  }
+  ::close(epoll_fd);
+  ::close(fds[0]);
+  wait_for(server);
+  return round_trips;
+}
+
 CpuPerMessage run_mqueue_floor_cpu(std::size_t count) {
   const std::string name = queue_name("cpu");
   mqd_t queue = open_queue(name);

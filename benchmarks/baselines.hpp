@@ -28,6 +28,12 @@ std::vector<std::int64_t> run_mqueue_fanout(std::size_t receivers, std::size_t c
 std::vector<std::int64_t> run_unix_socket_copy(std::size_t size, std::size_t count,
                                                std::size_t scratch_bytes);
 
+// Request to response over a Unix SOCK_SEQPACKET socket pair between two
+// processes, one byte each way, each side asleep in epoll_wait before it
+// reads, as agnocast's executor is: from the client's send to its return
+// from reading the answer (ns).  The floor of a service's round trip.
+std::vector<std::int64_t> run_unix_socket_request_response(std::size_t count);
+
 // User + system CPU of each side of the epoll floor per message, one
 // message a millisecond, over `count` messages after a warm-up.
 CpuPerMessage run_mqueue_floor_cpu(std::size_t count);

@@ -41,6 +41,8 @@ namespace {
 struct Plan {
   std::vector<std::size_t> sizes{64, 4 << 10, 1 << 20, 16 << 20, 64 << 20};
   std::vector<std::size_t> fanouts{1, 8, 64};
+  // Request and response payloads of the service's round trip.
+  std::vector<std::size_t> service_sizes{64, 4 << 20};
   std::size_t rounds = 20;
   std::size_t latency_samples = 9;         // per series and round
   std::size_t constant_bytes_samples = 2;  // each writes 64 MiB first
@@ -71,6 +73,7 @@ struct Plan {
     latency_samples = 2;
     constant_bytes_samples = 1;
     fanout_samples = 1;
+    service_sizes = {64};
     steady_messages = 30;
     throughput_count = 200;
   }
@@ -288,8 +291,9 @@ json syscalls_json(const bench::SteadyResult& steady) {
 
 // agnocast-bench-breakdown's report, run as a program of its own (it
 // replaces the C library's calls libagnocast makes); null when it fails.
-json cost_breakdown(const std::string& program, bool smoke) {
-  const std::string command = program + (smoke ? " --count 5 --rounds 5" : "");
+// `what`: its options for what to time ("--service"), or none.
+json cost_breakdown(const std::string& program, bool smoke, const std::string& what = "") {
+  const std::string command = program + what + (smoke ? " --count 5 --rounds 5" : "");
   FILE* output = popen(command.c_str(), "r");
   if (!output) return nullptr;
   std::string text;
@@ -381,6 +385,18 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                          [&, size](auto&) { return iceoryx->measure(size, n, 0); }});
       }
     }
+    // Request → response: a service's round trip, as many bytes written
+    // before each sample for every size, beside two one-way publishes and
+    // the Unix socket's request/response floor.
+    for (std::size_t size : plan.service_sizes) {
+      const std::size_t scratch = plan.service_sizes.back() - size;
+      cells.push_back({"agnocast_service", bench::format_size(size),
+                       [=](auto&) { return bench::run_agnocast_round_trip(size, n, scratch); }});
+    }
+    cells.push_back(
+        {"agnocast_ping_pong", small, [=](auto&) { return bench::run_agnocast_ping_pong(64, n); }});
+    cells.push_back({"unix_socket_request_response", "1 B",
+                     [=](auto&) { return bench::run_unix_socket_request_response(n); }});
     // 63 topics of traffic beside the measured one need cores of their own:
     // on icount's single vCPU the measured message would wait for them.
     if (!plan.icount) {
@@ -465,8 +481,9 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   // Series in a fixed order, sizes and subscriber counts ascending.
   const std::string smallest_label = bench::format_size(plan.sizes.front());
   const std::string largest_label = bench::format_size(plan.sizes.back());
-  std::vector<std::string> size_labels, fanout_labels;
+  std::vector<std::string> size_labels, fanout_labels, service_labels;
   for (std::size_t size : plan.sizes) size_labels.push_back(bench::format_size(size));
+  for (std::size_t size : plan.service_sizes) service_labels.push_back(bench::format_size(size));
   for (std::size_t subscribers : plan.fanouts) fanout_labels.push_back(std::to_string(subscribers));
   const std::vector<std::pair<std::string, std::vector<std::string>>> series{
       {"mqueue_floor", {"1 B"}},
@@ -480,6 +497,9 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       {"python_subscriber_constant_bytes", {smallest_label, largest_label}},
       {"agnocast_fanout", fanout_labels},
       {"mqueue_fanout", fanout_labels},
+      {"agnocast_service", service_labels},
+      {"agnocast_ping_pong", {small}},
+      {"unix_socket_request_response", {"1 B"}},
   };
   for (const auto& [who, labels] : series) {
     for (const auto& label : labels) {
@@ -523,6 +543,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   };
   const std::string largest = bench::format_size(plan.sizes.back());
   const std::string smallest = bench::format_size(plan.sizes.front());
+  const std::string largest_service = bench::format_size(plan.service_sizes.back());
   auto slope = [&](std::size_t round, const char* who) {
     const double first = static_cast<double>(plan.fanouts.front());
     const double last = static_cast<double>(plan.fanouts.back());
@@ -571,6 +592,16 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
        [&](std::size_t r) {
          return p50(r, "agnocast_fanout", std::to_string(plan.fanouts.back())) /
                 p50(r, "agnocast_fanout", std::to_string(plan.fanouts.front()));
+       }},
+      {"service_vs_one_way", 2.2, 2.2,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_service", small) / p50(r, "agnocast", small);
+       }},
+      {"service_size_flatness", 1.02, 1.02,
+       [&](std::size_t r) {
+         // A smoke run measures the smallest size only.
+         if (plan.service_sizes.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+         return p50(r, "agnocast_service", largest_service) / p50(r, "agnocast_service", small);
        }},
   };
   for (const RoundRatio& ratio : ratios) {
@@ -628,6 +659,10 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
         samples.round_p50(all_rounds, "mqueue_floor", "1 B") * 1000;
   }
   report["cost_breakdown"] = breakdown;
+  if (plan.selected("cost_breakdown_service")) {
+    std::cerr << "the cost of one round trip of a service, call by call...\n";
+    report["cost_breakdown_service"] = cost_breakdown(breakdown_program, plan.smoke, " --service");
+  }
   if (!plan.series.empty()) return report;  // a selection: its series only
 
   std::cerr << "system calls and CPU time at 1 kHz...\n";

@@ -5,7 +5,9 @@
 // latency series, the library's own user-space time between them, and, in
 // loops in the same boot, reference calls: a null ioctl
 // (AGNOCAST_IOC_GET_VERSION), getppid() and a non-blocking mq_send,
-// mq_receive and epoll_wait.  Prints one JSON object.
+// mq_receive and epoll_wait.  Prints one JSON object.  With --service it
+// times a service's 64 B request → response round trip instead, call by call
+// on the client and on the server, as run_agnocast_round_trip runs it.
 #include <agnocast.h>
 #include <fcntl.h>
 #include <mqueue.h>
@@ -20,6 +22,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -28,6 +31,7 @@
 #include <system_error>
 #include <vector>
 
+#include "bench_service.hpp"
 #include "bench_support.hpp"
 #include "call_timer.hpp"
 
@@ -51,7 +55,14 @@ namespace {
 using json = nlohmann::ordered_json;
 
 // The benchmark's own spans on the timeline.
-enum Mark : std::int64_t { borrow = 1, publish = 2, callback = 3 };
+enum Mark : std::int64_t {
+  borrow = 1,
+  publish = 2,
+  callback = 3,
+  send_request = 4,
+  response_callback = 5,
+  serve = 6
+};
 
 double median_of(std::vector<std::int64_t> values) {
   if (values.empty()) return 0;
@@ -406,6 +417,174 @@ json analyse(const Sides& sides) {
           {"timeline", timeline}};
 }
 
+// One 64 B request in flight at a time, as in the round-trip series: the
+// client writes it, sends it and spins until its response callback runs,
+// then pauses; the server answers from its callback with a response written
+// before the first request.  Both record every call after the warm-up.
+Sides run_service_scenario(std::size_t warmup, std::size_t count) {
+  const std::string name = "/bench/breakdown_service_" + std::to_string(getpid());
+  const std::size_t total = warmup + count;
+  Pipe ready = Pipe::open(), stop = Pipe::open(), client_calls = Pipe::open(),
+       server_calls = Pipe::open();
+  const pid_t server = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_breakdown_server"};
+    std::vector<agnocast::ipc_shared_ptr<BenchResponse>> responses;
+    std::size_t answered = 0;
+    auto service = node.create_service<BenchService>(
+        name, [&](std::shared_ptr<agnocast::Service<BenchService>> serving, agnocast::RequestId id,
+                  agnocast::ipc_shared_ptr<const BenchRequest>) {
+          const std::int64_t t = now_ns();
+          serving->send_response(id, std::move(responses.at(answered)));
+          mark(Mark::serve, t, now_ns());
+          if (++answered == warmup) start_recording(count * 64);
+        });
+    for (std::size_t seq = 0; seq < total; ++seq) {
+      auto response = service->borrow_loaned_response();
+      response->payload.resize(64);
+      responses.push_back(std::move(response));
+    }
+    executor.add_fd(stop.read_fd, [&] { executor.cancel(); });
+    executor.add_node(node);
+    char byte = 1;
+    write_all(ready.write_fd, &byte, 1);
+    executor.spin();
+    stop_recording();
+    send_calls(server_calls.write_fd);
+    return 0;
+  });
+  const pid_t client = spawn([&] {
+    agnocast::SingleThreadedExecutor executor;
+    agnocast::Node node{"bench_breakdown_client"};
+    auto caller = node.create_client<BenchService>(name);
+    char byte = 0;
+    if (!read_all(ready.read_fd, &byte, 1)) return 1;
+    if (!caller->wait_for_service(std::chrono::seconds(60))) return 1;
+    executor.add_node(node);
+    for (std::size_t seq = 0; seq < total; ++seq) {
+      if (seq == warmup) start_recording(count * 64);
+      auto request = caller->borrow_loaned_request();
+      request->seq = seq;
+      request->payload.resize(64);
+      fill_payload(std::span(request->payload.data(), 64), seq);
+      bool answered = false;
+      const std::int64_t t0 = now_ns();
+      caller->async_send_request(std::move(request),
+                                 [&](agnocast::Client<BenchService>::SharedFuture future) {
+                                   const std::int64_t t1 = now_ns();
+                                   answered = future.valid();
+                                   mark(Mark::response_callback, t1, t1);
+                                 });
+      mark(Mark::send_request, t0, now_ns());
+      while (!answered) {
+        if (!executor.spin_once(std::chrono::seconds(60))) return 1;
+      }
+      settle_between_messages();
+    }
+    stop_recording();
+    byte = 1;
+    write_all(stop.write_fd, &byte, 1);
+    send_calls(client_calls.write_fd);
+    return 0;
+  });
+  client_calls.close_write();
+  server_calls.close_write();
+  Sides sides{receive_calls(client_calls.read_fd), receive_calls(server_calls.read_fd)};
+  reap(client);
+  reap(server);
+  return sides;
+}
+
+// The round trips' windows: per side, the calls made in each window and the
+// library's own time (the side's running time in the window less its
+// calls); what is left of a window is neither side running in user space or
+// in a timed call: the wake-ups' context switches.  `sides.publisher` holds
+// the client, `sides.subscriber` the server.
+json analyse_service(const Sides& sides) {
+  const auto& client = sides.publisher;
+  const auto& server = sides.subscriber;
+  std::vector<const TimedCall*> sends, answers, serves;
+  for (const TimedCall& call : client) {
+    if (is_mark(call, Mark::send_request)) sends.push_back(&call);
+    if (is_mark(call, Mark::response_callback)) answers.push_back(&call);
+  }
+  for (const TimedCall& call : server) {
+    if (is_mark(call, Mark::serve)) serves.push_back(&call);
+  }
+  const std::size_t messages = std::min({sends.size(), answers.size(), serves.size()});
+  if (messages == 0) throw std::runtime_error("the service breakdown recorded no whole round trip");
+  // A side's running spans in [from, to]: between the returns of its blocking
+  // waits and the starts of the next ones.
+  auto running = [](const std::vector<TimedCall>& calls, std::int64_t from, std::int64_t to) {
+    std::vector<std::pair<std::int64_t, std::int64_t>> spans;
+    std::int64_t start = from;
+    bool awake = true;
+    for (const TimedCall& call : calls) {
+      if (!is_wait(call) || call.end_ns < from || call.start_ns > to) continue;
+      if (awake && call.start_ns >= start) spans.emplace_back(start, call.start_ns);
+      start = call.end_ns;
+      awake = call.end_ns <= to;
+    }
+    if (awake && start < to) spans.emplace_back(start, to);
+    return spans;
+  };
+  SideCosts client_costs, server_costs;
+  std::vector<std::int64_t> round_trips, switches;
+  for (std::size_t k = 0; k < messages; ++k) {
+    const std::int64_t t0 = sends[k]->start_ns, t1 = answers[k]->start_ns;
+    round_trips.push_back(t1 - t0);
+    std::int64_t accounted = 0;
+    for (auto [side, calls] :
+         {std::pair{&client_costs, &client}, std::pair{&server_costs, &server}}) {
+      std::int64_t run = 0, in_calls = 0;
+      for (const auto& [from, to] : running(*calls, t0, t1)) {
+        run += to - from;
+        side->add_calls_within(*calls, from, to, in_calls);
+      }
+      side->library_ns.push_back(run - in_calls);
+      ++side->messages;
+      accounted += run;
+    }
+    switches.push_back(t1 - t0 - accounted);
+  }
+
+  // The round trip of median time, both sides' calls on one timeline.
+  std::vector<std::size_t> order(messages);
+  for (std::size_t k = 0; k < messages; ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return round_trips[a] < round_trips[b]; });
+  const std::size_t typical = order[(messages - 1) / 2];
+  const std::int64_t t0 = sends[typical]->start_ns, t1 = answers[typical]->start_ns;
+  json timeline = json::array();
+  std::vector<std::pair<const TimedCall*, const char*>> spans;
+  for (const TimedCall& call : client) {
+    if (call.end_ns >= t0 && call.start_ns <= t1) spans.emplace_back(&call, "client");
+  }
+  for (const TimedCall& call : server) {
+    if (call.end_ns >= t0 && call.start_ns <= t1) spans.emplace_back(&call, "server");
+  }
+  std::sort(spans.begin(), spans.end(),
+            [](const auto& a, const auto& b) { return a.first->start_ns < b.first->start_ns; });
+  for (const auto& [call, side] : spans) {
+    std::string what = call_name(*call);
+    if (call->kind == CallKind::mark) {
+      what = call->detail == Mark::send_request ? "async_send_request()"
+             : call->detail == Mark::serve      ? "server's callback"
+                                                : "response callback";
+    }
+    // A wait that began before the window: only its return is in it.
+    const std::int64_t start = std::max(call->start_ns, t0);
+    timeline.push_back(
+        {{"side", side}, {"what", what}, {"start_ns", start - t0}, {"end_ns", call->end_ns - t0}});
+  }
+  return {{"messages", messages},
+          {"round_trip_ns", median_of(round_trips)},
+          {"client", client_costs.to_json(nullptr)},
+          {"server", server_costs.to_json(nullptr)},
+          {"switches_ns", median_of(switches)},
+          {"timeline", timeline}};
+}
+
 }  // namespace
 }  // namespace agnocast::bench
 
@@ -417,8 +596,16 @@ int main(int argc, char** argv) {
   app.add_option("--warmup", warmup, "messages before the recorded ones")
       ->check(CLI::Range(1, 1000));
   app.add_option("--rounds", rounds, "calls of each reference loop")->check(CLI::Range(1, 100000));
+  bool service = false;
+  app.add_flag("--service", service,
+               "a service's 64 B round trip instead of a message, without the references");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (service) {
+      std::cout << bench::analyse_service(bench::run_service_scenario(warmup, count)).dump()
+                << "\n";
+      return 0;
+    }
     nlohmann::ordered_json result = bench::analyse(bench::run_scenario(warmup, count));
     result["reference"] = bench::references(rounds);
     std::cout << result.dump() << "\n";

@@ -169,6 +169,40 @@ void print_breakdown(const json& breakdown) {
   }
 }
 
+// A service's round trip, call by call: what each side runs in its window.
+void print_service_breakdown(const json& breakdown) {
+  if (!breakdown.is_object()) return;
+  std::printf(
+      "\nCost of one 64 B request → response round trip of a service, call by call (%s round "
+      "trips one at a time; round trip p50 in this run %s ns), calls and user space within the "
+      "window only:\n\n| side | call | per round trip | ns each (p50) |\n|---|---|---|---|\n",
+      number(breakdown["messages"], "%.0f").c_str(),
+      number(breakdown["round_trip_ns"], "%.0f").c_str());
+  for (const char* side : {"client", "server"}) {
+    const json& costs = breakdown[side];
+    for (const json& call : costs["calls"]) {
+      std::printf("| %s | `%s` | %s | %s |\n", side, call["name"].get<std::string>().c_str(),
+                  number(call["per_message"], "%.2f").c_str(), number(call["ns"], "%.0f").c_str());
+    }
+    std::printf("| %s | library, user space | 1 | %s |\n", side,
+                number(costs["library_ns"], "%.0f").c_str());
+  }
+  std::printf(
+      "\nLeft of the window, neither side in user space nor in a timed call (the two wake-ups' "
+      "context switches): %s ns.\n",
+      number(breakdown["switches_ns"], "%.0f").c_str());
+  if (!breakdown["timeline"].empty()) {
+    std::printf(
+        "\nThe round trip of median time on one timeline (ns from the "
+        "`async_send_request()` call):\n\n| side | what | start | end |\n|---|---|---|---|\n");
+    for (const json& span : breakdown["timeline"]) {
+      std::printf("| %s | %s | %s | %s |\n", span["side"].get<std::string>().c_str(),
+                  span["what"].get<std::string>().c_str(), number(span["start_ns"], "%.0f").c_str(),
+                  number(span["end_ns"], "%.0f").c_str());
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> report_shape_errors(const json& report) {
@@ -204,6 +238,15 @@ std::vector<std::string> report_shape_errors(const json& report) {
   }
   for (const char* size : {"64 B", "64 MiB"})
     check.latency("python_subscriber_constant_bytes", size);
+  // The request → response round trip and its two references; a smoke run
+  // measures the smallest size only.
+  const bool smoke = report.value("smoke", false);
+  check.latency("agnocast_service", "64 B");
+  if (!smoke) check.latency("agnocast_service", "4 MiB");
+  check.latency("agnocast_ping_pong", "64 B");
+  check.latency("unix_socket_request_response", "1 B");
+  check.ratio("service_vs_one_way", icount);
+  if (!smoke) check.ratio("service_size_flatness", icount);
   // The slope's difference of p50s may be negative in a tiny smoke run, so
   // fanout_slope is only required to be there.
   for (const char* name :
@@ -253,6 +296,9 @@ std::vector<std::string> report_shape_errors(const json& report) {
                                 "epoll_wait_ready_ns", "mqueue_hop_epoll_ns"}) {
     check.positive({"cost_breakdown", "reference", reference});
   }
+  check.positive({"cost_breakdown_service", "round_trip_ns"});
+  check.positive({"cost_breakdown_service", "client", "library_ns"});
+  check.positive({"cost_breakdown_service", "server", "library_ns"});
   const std::pair<const char*, const char*> essential[] = {
       {"publisher", "ioctl PUBLISH"}, {"publisher", "mq_send"}, {"subscriber", "ioctl RECEIVE"}};
   for (const auto& [side, name] : essential) {
@@ -353,6 +399,19 @@ void print_markdown(const json& report) {
     }
   }
 
+  // Reports from before services were measured have none.
+  if (latency.contains("agnocast_service")) {
+    std::printf(
+        "\n| request → response round trip, %s (p50 / p99) | 64 B | 4 MiB |\n|---|---|---|\n"
+        "| agnocast service: `async_send_request()` to the response callback | %s | %s |\n"
+        "| two one-way publishes: a ping and its pong on two agnocast topics | %s | |\n"
+        "| Unix socket (`SOCK_SEQPACKET`, 1 B each way, both sides in `epoll_wait`) | %s | |\n",
+        unit, cell(latency, "agnocast_service", "64 B").c_str(),
+        cell(latency, "agnocast_service", "4 MiB").c_str(),
+        cell(latency, "agnocast_ping_pong", "64 B").c_str(),
+        cell(latency, "unix_socket_request_response", "1 B").c_str());
+  }
+
   if (icount) {
     std::printf("\n| ratio (lower is better) | value | target | met |\n|---|---|---|---|\n");
   } else {
@@ -415,6 +474,9 @@ void print_markdown(const json& report) {
         number(allocations["subscriber"], "%.2f").c_str());
   }
   if (report.contains("cost_breakdown")) print_breakdown(report["cost_breakdown"]);
+  if (report.contains("cost_breakdown_service")) {
+    print_service_breakdown(report["cost_breakdown_service"]);
+  }
   const json& slopes = report["fanout_slope_us_per_subscriber"];
   std::printf("\nFan-out slope, µs per extra subscriber: agnocast %s, mqueue wake-ups %s.\n",
               number(slopes["agnocast"], "%.1f").c_str(), number(slopes["mqueue"], "%.1f").c_str());
@@ -541,6 +603,40 @@ void print_why_latency_stands(const json& icount) {
       budget - kernel_path, fits ? "it fits" : "less than it takes now");
 }
 
+// The service's two targets, each with the references it is set beside.
+void print_round_trip_standing(const json& report, const char* format, bool with_interval) {
+  const json& latency = report["latency"];
+  auto interval = [&](const char* name) {
+    return with_interval ? at_path(report, {"ratio_ci", name}) : json();
+  };
+  const double scale = with_interval ? 1 : 1000;  // µs, or ns in icount
+  const char* unit_name = with_interval ? "µs" : "ns";
+  auto p50 = [&](const char* who, const char* label) {
+    return number_or_nan(at_path(latency, {who, label, "p50_us"})) * scale;
+  };
+  const double round_trip = p50("agnocast_service", "64 B");
+  std::printf(
+      "- a service's request → response round trip ≤ 2.2 × the one-way 64 B latency "
+      "(`service_vs_one_way`): %s",
+      standing(at_path(report, {"ratios", "service_vs_one_way"}), 2.2, format,
+               interval("service_vs_one_way"))
+          .c_str());
+  if (!std::isnan(round_trip)) {
+    const double ping_pong = p50("agnocast_ping_pong", "64 B");
+    const double socket = p50("unix_socket_request_response", "1 B");
+    std::printf(
+        " (%.0f %s against %.0f one way; two one-way publishes %.0f, the round trip %.2f × "
+        "theirs; the Unix socket's request/response %.0f, %.2f × its)",
+        round_trip, unit_name, p50("agnocast", "64 B"), ping_pong, round_trip / ping_pong, socket,
+        round_trip / socket);
+  }
+  std::printf(
+      "\n- the round trip as fast at 4 MiB as at 64 B (`service_size_flatness` ≤ 1.02): %s\n",
+      standing(at_path(report, {"ratios", "service_size_flatness"}), 1.02, format,
+               interval("service_size_flatness"))
+          .c_str());
+}
+
 }  // namespace
 
 void print_readme(const json& combined) {
@@ -632,7 +728,21 @@ times a C++ publisher of `sensor_msgs/PointCloud2` to the first line of a
 Python subscription's callback (`time.monotonic_ns()` against the publish time
 the library stamps), which then checks the message through the numpy view of
 the publisher's memory; `python_size_flatness` is its 64 MiB p50 over its 64 B
-p50. System calls are
+p50.
+
+A service's round trip is timed from `async_send_request()`, the request
+already written, to the first line of the client's response callback, one
+request in flight, both sides asleep (the client paused, the server in
+`epoll_wait`) before each sample. The request and the response each carry the
+payload; the server answers from its callback with a response it wrote before
+the first request came (the deferred form's `send_response()`, so that, as
+the request's, the response's bytes are written outside the window), and the
+client writes 4 MiB before each sample at every size (payload + scratch).
+Beside it, timed the same way: two one-way publishes (a 64 B ping on one
+agnocast topic whose callback publishes a pong written beforehand on another,
+to the pong's callback) and a Unix `SOCK_SEQPACKET` socket pair carrying one
+byte each way, each side asleep in `epoll_wait` before it reads, as
+agnocast's executor is. System calls are
 counted (perf counters on the syscall tracepoints) in a run of their own;
 CPU time per message (user + system, 1 message a millisecond) is taken
 without counters for agnocast, iceoryx and the floor alike. iceoryx is
@@ -646,7 +756,11 @@ per side, the library's own user-space time (`borrow_loaned_message()` and
 `publish()` on the publisher, wake-up to callback and callback to next wait on
 the subscriber, less the calls in them), and the message of median latency on
 one timeline. The references are timed the same way in loops in the same
-boot; the mqueue hops are the floors' p50s of the same run.
+boot; the mqueue hops are the floors' p50s of the same run. Its `--service`
+run times a service's 64 B round trip the same way (50 one at a time, the
+server answering with a response written beforehand): the calls each side
+makes within the window, each side's own user-space time in it, and what is
+left, the context switches of the two wake-ups.
 
 **Recording** (ordinary mode only: it is CPU time at a real rate) runs
 `agnocast-cli bag record` with its defaults (zstd, chunks of about 1 MiB) on
@@ -730,8 +844,10 @@ depend on it.
       "publisher 1 + N (N = 4 subscribers): %.2f: %s\n",
       sub_10, sub_1, sub_10 <= 3 && sub_1 <= 3 ? "**met**" : "**not met**", pub_4,
       pub_4 <= 5 ? "**met**" : "**not met**");
+  print_round_trip_standing(icount, "%.3f", false);
   print_why_latency_stands(icount);
   std::printf("\nIn ordinary mode (whole 95 %% interval under the target):\n\n");
+  print_round_trip_standing(ordinary, "%.2f", true);
   std::printf("- `size_flatness` ≤ 1.05: %s\n",
               standing(at_path(ordinary, {"ratios", "size_flatness"}), 1.05, "%.2f",
                        at_path(ordinary, {"ratio_ci", "size_flatness"}))

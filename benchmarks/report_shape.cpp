@@ -637,6 +637,47 @@ void print_round_trip_standing(const json& report, const char* format, bool with
           .c_str());
 }
 
+// Where a service's round trip goes, from its breakdown: each side's timed
+// calls and user space, the wake-ups, and the server's tail after its
+// callback, which icount's one vCPU runs before the woken client.
+void print_why_round_trip_stands(const json& icount) {
+  const json& breakdown = icount["cost_breakdown_service"];
+  if (!breakdown.is_object()) return;
+  auto calls_of = [&](const char* side) {
+    double sum = 0;
+    std::string names;
+    for (const json& call : at_path(breakdown, {side, "calls"})) {
+      sum += number_or_nan(call["per_message"]) * number_or_nan(call["ns"]);
+      names += (names.empty() ? "" : ", ") + call.value("name", std::string());
+    }
+    return std::pair{sum, names};
+  };
+  const auto [client_calls, client_names] = calls_of("client");
+  const auto [server_calls, server_names] = calls_of("server");
+  double callback_end = std::numeric_limits<double>::quiet_NaN(), tail = callback_end;
+  for (const json& span : breakdown["timeline"]) {
+    const std::string what = span.value("what", std::string());
+    if (what == "server's callback") callback_end = number_or_nan(span["end_ns"]);
+    if (what == "epoll_wait" && span.value("side", std::string()) == "server" &&
+        number_or_nan(span["start_ns"]) > callback_end && std::isnan(tail)) {
+      tail = number_or_nan(span["start_ns"]) - callback_end;
+    }
+  }
+  std::printf(
+      "\nWhere the round trip goes (the breakdown's run, %s ns, each timed call with two clock "
+      "reads more): the client's calls (%s) %.0f and its user space %s (`async_send_request()`, "
+      "the executor's wake-up and the answer's way through the pending request's promise to the "
+      "callback); the server's calls (%s) %.0f and its user space %s; the two wake-ups' context "
+      "switches %s.  On icount's one vCPU the woken client runs only once the server sleeps "
+      "again, so the server's tail after its callback (the request's notification taken, back "
+      "into `epoll_wait`: %.0f) is inside the window; on two cores it would overlap the "
+      "client's wake-up.\n",
+      number(breakdown["round_trip_ns"], "%.0f").c_str(), client_names.c_str(), client_calls,
+      number(at_path(breakdown, {"client", "library_ns"}), "%.0f").c_str(), server_names.c_str(),
+      server_calls, number(at_path(breakdown, {"server", "library_ns"}), "%.0f").c_str(),
+      number(breakdown["switches_ns"], "%.0f").c_str(), tail);
+}
+
 }  // namespace
 
 void print_readme(const json& combined) {
@@ -669,6 +710,14 @@ void print_readme(const json& combined) {
   both("guest memory, MiB", {"machine", "memory_mib"}, "%.0f");
   both("clock source", {"machine", "clocksource"}, "%g");
   both("rounds", {"rounds"}, "%.0f");
+  // A mode measured again alone keeps the other's run: each mode's date.
+  auto date_of = [&](const char* mode) {
+    const json& date = at_path(combined, {"dates", mode});
+    return date.is_string() ? date.get<std::string>()
+                            : combined.value("date", std::string("undated"));
+  };
+  std::printf("| date of the run | %s | %s |\n", date_of("icount").c_str(),
+              date_of("ordinary").c_str());
   auto randomized = [](const json& report) {
     const json& value = at_path(report, {"machine", "address_randomization"});
     return value.is_boolean() ? (value.get<bool>() ? "on" : "off") : "on (not recorded)";
@@ -846,6 +895,7 @@ depend on it.
       pub_4 <= 5 ? "**met**" : "**not met**");
   print_round_trip_standing(icount, "%.3f", false);
   print_why_latency_stands(icount);
+  print_why_round_trip_stands(icount);
   std::printf("\nIn ordinary mode (whole 95 %% interval under the target):\n\n");
   print_round_trip_standing(ordinary, "%.2f", true);
   std::printf("- `size_flatness` ≤ 1.05: %s\n",

@@ -625,8 +625,8 @@ void print_round_trip_standing(const json& report, const char* format, bool with
     const double ping_pong = p50("agnocast_ping_pong", "64 B");
     const double socket = p50("unix_socket_request_response", "1 B");
     std::printf(
-        " (%.0f %s against %.0f one way; two one-way publishes %.0f, the round trip %.2f × "
-        "theirs; the Unix socket's request/response %.0f, %.2f × its)",
+        " (%.0f %s against %.0f one way; two one-way publishes: %.0f, the round trip %.2f × "
+        "that; the Unix socket floor: %.0f, the round trip %.2f × that)",
         round_trip, unit_name, p50("agnocast", "64 B"), ping_pong, round_trip / ping_pong, socket,
         round_trip / socket);
   }
@@ -897,7 +897,6 @@ depend on it.
   print_why_latency_stands(icount);
   print_why_round_trip_stands(icount);
   std::printf("\nIn ordinary mode (whole 95 %% interval under the target):\n\n");
-  print_round_trip_standing(ordinary, "%.2f", true);
   std::printf("- `size_flatness` ≤ 1.05: %s\n",
               standing(at_path(ordinary, {"ratios", "size_flatness"}), 1.05, "%.2f",
                        at_path(ordinary, {"ratio_ci", "size_flatness"}))
@@ -914,6 +913,7 @@ depend on it.
               standing(at_path(ordinary, {"ratios", "topics_64"}), 1.2, "%.2f",
                        at_path(ordinary, {"ratio_ci", "topics_64"}))
                   .c_str());
+  print_round_trip_standing(ordinary, "%.2f", true);
   std::printf("%s", R"(
 Where icount and the ordinary mode disagree (agnocast and iceoryx close in
 one, several times apart in the other, above all after 64 MiB of writes), the

@@ -46,6 +46,11 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_EQ(config.module_parameters.at("pool_size"), "1048576");
   EXPECT_EQ(config.module_parameters.at("debug"), "1");
   EXPECT_EQ(config.module_parameters.at("name"), "x");
+  EXPECT_EQ(parse_config(R"({"module_parameters": {"pool_base": 18446744073709551615}})")
+                .module_parameters.at("pool_base"),
+            "18446744073709551615");
+  EXPECT_EQ(parse_config(R"({"module_parameters": {"offset": -4}})").module_parameters.at("offset"),
+            "-4");
   EXPECT_TRUE(config.unload_on_exit);
   EXPECT_EQ(config.mqueue.msg_max, 64);
   EXPECT_EQ(config.mqueue.queues_max, 1024);

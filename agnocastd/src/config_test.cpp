@@ -131,6 +131,9 @@ TEST(ConfigAccess, ErrorsNameTheKeyPath) {
             "config key 'access.rules[0].publish[0]': expected \"user:NAME\", \"group:NAME\" "
             "(or a numeric id) or \"*\", got \"team:x\"");
   EXPECT_EQ(
+      error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["user:root\u0000x"]}]}})"),
+      "config key 'access.rules[0].publish[0]': a user name may not hold a NUL byte");
+  EXPECT_EQ(
       error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["user:4294967295"]}]}})"),
       "config key 'access.rules[0].publish[0]': id 4294967295 is out of range");
   EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": "group:root"}]}})"),

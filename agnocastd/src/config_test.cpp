@@ -86,6 +86,8 @@ TEST(Config, ErrorsNameTheKey) {
             "off");
   EXPECT_EQ(error_of("[]"), "config key '(top level)': expected an object");
   EXPECT_EQ(error_of("{").rfind("not valid JSON: ", 0), 0u);
+  // A number no double holds: nlohmann throws out_of_range, not parse_error.
+  EXPECT_EQ(error_of(R"({"sweep_interval_s": 2684E35456})").rfind("not valid JSON: ", 0), 0u);
 }
 
 TEST(ConfigAccess, AbsentMeansNoPolicy) { EXPECT_FALSE(parse_config("{}").access); }

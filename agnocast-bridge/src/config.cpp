@@ -113,7 +113,7 @@ Config parse_config(std::string_view json_text) {
   json document;
   try {
     document = json::parse(json_text);
-  } catch (const json::parse_error& error) {
+  } catch (const json::exception& error) {  // a parse_error, or out_of_range for 1e400
     throw ConfigError("", std::string("not valid JSON: ") + error.what());
   }
   if (!document.is_object()) throw ConfigError("", "the configuration must be a JSON object");

@@ -48,6 +48,8 @@ TEST(Config, OneTopicMayBeBridgedBothWays) {
 TEST(Config, ErrorsNameTheKey) {
   const std::string topic = R"("name": "/t", "type": "std_msgs/msg/Header", "direction": "to_dds")";
   EXPECT_EQ(error_key("{"), "");
+  // A number no double holds: nlohmann throws out_of_range, not parse_error.
+  EXPECT_EQ(error_key(R"({"domain_id": 8889888e44444444, "topics": []})"), "");
   EXPECT_EQ(error_key("[]"), "");
   EXPECT_EQ(error_key("{}"), "topics");
   EXPECT_EQ(error_key(R"({"topics": {}})"), "topics");

@@ -65,6 +65,10 @@ AccessPrincipal parse_access_principal(std::string_view text) {
         "\"*\", got \"" +
         std::string(text) + "\"");
   }
+  // The name databases take C strings: "root\0x" would be looked up as "root".
+  if (name.find('\0') != std::string::npos) {
+    throw std::invalid_argument("a " + std::string(kind) + " name may not hold a NUL byte");
+  }
   const bool user = kind == "user";
   const auto principal_kind = user ? AccessPrincipal::Kind::user : AccessPrincipal::Kind::group;
   if (name.find_first_not_of("0123456789") == name.npos) {

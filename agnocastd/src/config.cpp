@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -62,6 +63,8 @@ mode_t octal_mode(const json& value, std::string_view key) {
 
 std::string parameter_value(const json& value, std::string_view key) {
   if (value.is_boolean()) return value.get<bool>() ? "1" : "0";
+  // Unsigned first: 2^64-1 (a ulong parameter) is not the long long -1.
+  if (value.is_number_unsigned()) return std::to_string(value.get<std::uint64_t>());
   if (value.is_number_integer()) return std::to_string(value.get<long long>());
   if (value.is_string()) {
     const auto string = value.get<std::string>();
@@ -268,7 +271,7 @@ Config parse_config(std::string_view json_text) {
   json document;
   try {
     document = json::parse(json_text, nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& error) {
+  } catch (const json::exception& error) {  // a parse_error, or out_of_range for 1e400
     throw ConfigError(std::string("not valid JSON: ") + error.what());
   }
   Config config;

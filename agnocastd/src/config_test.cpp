@@ -46,6 +46,11 @@ TEST(Config, ReadsEveryKey) {
   EXPECT_EQ(config.module_parameters.at("pool_size"), "1048576");
   EXPECT_EQ(config.module_parameters.at("debug"), "1");
   EXPECT_EQ(config.module_parameters.at("name"), "x");
+  EXPECT_EQ(parse_config(R"({"module_parameters": {"pool_base": 18446744073709551615}})")
+                .module_parameters.at("pool_base"),
+            "18446744073709551615");
+  EXPECT_EQ(parse_config(R"({"module_parameters": {"offset": -4}})").module_parameters.at("offset"),
+            "-4");
   EXPECT_TRUE(config.unload_on_exit);
   EXPECT_EQ(config.mqueue.msg_max, 64);
   EXPECT_EQ(config.mqueue.queues_max, 1024);
@@ -81,6 +86,8 @@ TEST(Config, ErrorsNameTheKey) {
             "off");
   EXPECT_EQ(error_of("[]"), "config key '(top level)': expected an object");
   EXPECT_EQ(error_of("{").rfind("not valid JSON: ", 0), 0u);
+  // A number no double holds: nlohmann throws out_of_range, not parse_error.
+  EXPECT_EQ(error_of(R"({"sweep_interval_s": 2684E35456})").rfind("not valid JSON: ", 0), 0u);
 }
 
 TEST(ConfigAccess, AbsentMeansNoPolicy) { EXPECT_FALSE(parse_config("{}").access); }
@@ -125,6 +132,9 @@ TEST(ConfigAccess, ErrorsNameTheKeyPath) {
   EXPECT_EQ(error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["team:x"]}]}})"),
             "config key 'access.rules[0].publish[0]': expected \"user:NAME\", \"group:NAME\" "
             "(or a numeric id) or \"*\", got \"team:x\"");
+  EXPECT_EQ(
+      error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["user:root\u0000x"]}]}})"),
+      "config key 'access.rules[0].publish[0]': a user name may not hold a NUL byte");
   EXPECT_EQ(
       error_of(R"({"access": {"rules": [{"topics": "/a", "publish": ["user:4294967295"]}]}})"),
       "config key 'access.rules[0].publish[0]': id 4294967295 is out of range");

@@ -6,11 +6,38 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <iterator>
+#include <optional>
 #include <system_error>
 
 namespace agnocast::mcap {
 namespace {
+
+// "Chunk (0x06)", or "opcode 0x7f" for one the format does not define.
+std::string opcode_name(std::uint8_t opcode) {
+  static constexpr const char* names[] = {
+      nullptr,    "Header",        "Footer",        "Schema",     "Channel",         "Message",
+      "Chunk",    "MessageIndex",  "ChunkIndex",    "Attachment", "AttachmentIndex", "Statistics",
+      "Metadata", "MetadataIndex", "SummaryOffset", "DataEnd"};
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02x", opcode);
+  if (opcode < std::size(names) && names[opcode] != nullptr) {
+    return std::string(names[opcode]) + " (" + hex + ")";
+  }
+  return std::string("opcode ") + hex;
+}
+
+// A chunk holds Schema, Channel and Message records, and may hold records
+// the format does not define (a reader skips those); any other record, a
+// Chunk above all, is damage.
+bool belongs_in_chunk(Opcode opcode) {
+  const auto value = static_cast<std::uint8_t>(opcode);
+  return opcode == Opcode::Schema || opcode == Opcode::Channel || opcode == Opcode::Message ||
+         value < static_cast<std::uint8_t>(Opcode::Header) ||
+         value > static_cast<std::uint8_t>(Opcode::DataEnd);
+}
 
 // The record at offset `at` of bytes, or nullopt when it does not fit
 // (problem says why).
@@ -23,9 +50,8 @@ std::optional<RecordView> record_at(std::span<const std::uint8_t> bytes, std::si
   std::uint64_t length = 0;
   std::memcpy(&length, bytes.data() + at + 1, sizeof length);
   if (length > bytes.size() - at - record_prefix_size) {
-    problem = "cut short inside a record (opcode 0x" +
-              std::to_string(static_cast<unsigned>(bytes[at])) + ", " + std::to_string(length) +
-              " bytes) at byte " + std::to_string(at);
+    problem = "cut short inside a record (" + opcode_name(bytes[at]) + ", " +
+              std::to_string(length) + " bytes) at byte " + std::to_string(at);
     return std::nullopt;
   }
   return RecordView{static_cast<Opcode>(bytes[at]),
@@ -46,7 +72,8 @@ MessageView parse_message_view(std::span<const std::uint8_t> content) {
   return view;
 }
 
-Reader::Reader(std::string path) : path_(std::move(path)) {
+Reader::Reader(std::string path, ReaderOptions options)
+    : path_(std::move(path)), options_(options) {
   const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw std::system_error(errno, std::generic_category(), path_);
   struct stat info {};
@@ -175,12 +202,21 @@ void Reader::read_summary() {
 ScanResult Reader::scan(const Visitor& visitor, bool verify_crcs) const {
   ScanResult result;
   const std::span<const std::uint8_t> all = bytes();
-  auto visit_records = [&](std::span<const std::uint8_t> records, bool in_chunk) -> bool {
+  // The records of the chunk at byte chunk_at of the file, or one record outside chunks.
+  auto visit_records = [&](std::span<const std::uint8_t> records,
+                           std::optional<std::size_t> chunk_at) -> bool {
     for (std::size_t at = 0; at < records.size();) {
       std::string problem;
       const auto record = record_at(records, at, problem);
       if (!record) {
-        result.stopped = (in_chunk ? "a chunk's records are " : "") + problem;
+        result.stopped = (chunk_at ? "a chunk's records are " : "") + problem;
+        return false;
+      }
+      if (chunk_at && !belongs_in_chunk(record->opcode)) {
+        result.stopped = "the chunk at byte " + std::to_string(*chunk_at) + " holds a " +
+                         opcode_name(records[at]) + " record (at byte " + std::to_string(at) +
+                         " of its records): a chunk holds only Schema, Channel and Message "
+                         "records";
         return false;
       }
       switch (record->opcode) {
@@ -224,7 +260,8 @@ ScanResult Reader::scan(const Visitor& visitor, bool verify_crcs) const {
         case Opcode::Chunk: {
           const Chunk chunk = parse_chunk(record->content);
           const std::vector<std::uint8_t> records =
-              decompress(chunk.compression, chunk.records, chunk.uncompressed_size);
+              decompress(chunk.compression, chunk.records, chunk.uncompressed_size,
+                         options_.chunk_records_max);
           if (verify_crcs && chunk.uncompressed_crc != 0 &&
               crc32(records) != chunk.uncompressed_crc) {
             result.stopped = "the chunk at byte " + std::to_string(at) + " fails its CRC";
@@ -233,7 +270,7 @@ ScanResult Reader::scan(const Visitor& visitor, bool verify_crcs) const {
           ++result.chunks;
           result.compressions.insert(chunk.compression);
           if (visitor.chunk) visitor.chunk(chunk);
-          if (!visit_records(records, true)) return result;
+          if (!visit_records(records, at)) return result;
           break;
         }
         case Opcode::Metadata:
@@ -243,7 +280,7 @@ ScanResult Reader::scan(const Visitor& visitor, bool verify_crcs) const {
           result.stopped = "a Footer before any DataEnd";
           return result;
         default:
-          if (!visit_records(all.subspan(at, record->size()), false)) return result;
+          if (!visit_records(all.subspan(at, record->size()), std::nullopt)) return result;
           break;
       }
     } catch (const FormatError& error) {

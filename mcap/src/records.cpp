@@ -597,7 +597,12 @@ std::vector<std::uint8_t> decompress_lz4(std::span<const std::uint8_t> bytes,
 
 std::vector<std::uint8_t> decompress(std::string_view compression,
                                      std::span<const std::uint8_t> bytes,
-                                     std::uint64_t uncompressed_size) {
+                                     std::uint64_t uncompressed_size, std::uint64_t max_size) {
+  if (uncompressed_size > max_size) {
+    throw FormatError("mcap: a chunk declares " + std::to_string(uncompressed_size) +
+                      " bytes of records, more than the " + std::to_string(max_size) +
+                      " a chunk may hold (the reader's limit)");
+  }
   if (compression.empty()) {
     if (bytes.size() != uncompressed_size) {
       throw FormatError("mcap: an uncompressed chunk's size differs from its declared size");

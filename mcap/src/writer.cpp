@@ -46,7 +46,9 @@ std::uint16_t Writer::add_schema(std::string name, std::string encoding,
                                  std::vector<std::uint8_t> data) {
   const auto id = static_cast<std::uint16_t>(schemas_.size() + 1);
   schemas_.push_back(Schema{id, std::move(name), std::move(encoding), std::move(data)});
-  write_record(chunk_records_, schemas_.back());
+  std::vector<std::uint8_t> record;
+  write_record(record, schemas_.back());
+  add_to_chunk(record);
   statistics_.schema_count = static_cast<std::uint16_t>(schemas_.size());
   return id;
 }
@@ -56,7 +58,9 @@ std::uint16_t Writer::add_channel(std::uint16_t schema_id, std::string topic, st
   const auto id = static_cast<std::uint16_t>(channels_.size() + 1);
   channels_.push_back(
       Channel{id, schema_id, std::move(topic), std::move(encoding), std::move(metadata)});
-  write_record(chunk_records_, channels_.back());
+  std::vector<std::uint8_t> record;
+  write_record(record, channels_.back());
+  add_to_chunk(record);
   statistics_.channel_count = static_cast<std::uint32_t>(channels_.size());
   statistics_.channel_message_counts[id] = 0;
   return id;
@@ -64,6 +68,14 @@ std::uint16_t Writer::add_channel(std::uint16_t schema_id, std::string topic, st
 
 void Writer::write_message(std::uint16_t channel_id, std::uint64_t log_time,
                            std::uint64_t publish_time, std::span<const std::uint8_t> data) {
+  if (data.size() > message_data_max) {
+    throw FormatError("mcap: a message of " + std::to_string(data.size()) +
+                      " bytes does not fit a chunk (at most " + std::to_string(message_data_max) +
+                      " bytes of data, so that readers accept the chunk)");
+  }
+  if (chunk_records_.size() + message_record_overhead + data.size() > default_chunk_records_max) {
+    flush_chunk();
+  }
   MessageIndex& index = chunk_message_indexes_[channel_id];
   index.channel_id = channel_id;
   index.records.emplace_back(log_time, chunk_records_.size());
@@ -91,6 +103,11 @@ void Writer::add_metadata(Metadata metadata) {
   metadata_indexes_.push_back(MetadataIndex{offset_, record.size(), metadata.name});
   put(record, true);
   ++statistics_.metadata_count;
+}
+
+void Writer::add_to_chunk(std::span<const std::uint8_t> record) {
+  if (chunk_records_.size() + record.size() > default_chunk_records_max) flush_chunk();
+  chunk_records_.insert(chunk_records_.end(), record.begin(), record.end());
 }
 
 void Writer::flush_chunk() {

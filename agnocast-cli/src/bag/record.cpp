@@ -74,7 +74,7 @@ struct RecordedTopic {
   std::uint16_t channel = 0;  // in the current file
   std::uint64_t messages = 0;
   std::uint64_t bytes = 0;
-  std::uint64_t invalid = 0;  // messages that could not be turned into CDR
+  std::uint64_t invalid = 0;  // messages that could not be turned into CDR or a chunk
   std::string last_problem;
 };
 
@@ -254,6 +254,13 @@ class Recorder {
     } catch (const cdr::Error& error) {
       ++topic.invalid;
       topic.last_problem = error.what();
+      return;
+    }
+    if (pending.bytes.size() > mcap::message_data_max) {  // no reader would take its chunk
+      ++topic.invalid;
+      topic.last_problem = "a message of " + std::to_string(pending.bytes.size()) +
+                           " bytes of CDR: an MCAP chunk holds at most " +
+                           std::to_string(mcap::message_data_max);
       return;
     }
     ++topic.messages;

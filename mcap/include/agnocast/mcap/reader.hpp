@@ -55,11 +55,17 @@ struct ScanResult {
   std::set<std::string> compressions;  // as named in the chunks, "" for none
 };
 
+struct ReaderOptions {
+  // A chunk declaring more records than this stops the scan before any is
+  // decompressed (default_chunk_records_max).
+  std::uint64_t chunk_records_max = default_chunk_records_max;
+};
+
 class Reader {
  public:
   // Maps path. Throws FormatError naming the path when it does not start with
   // the MCAP magic and a Header, std::system_error when it cannot be read.
-  explicit Reader(std::string path);
+  explicit Reader(std::string path, ReaderOptions options = {});
   ~Reader();
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
@@ -75,7 +81,11 @@ class Reader {
   const std::string& summary_problem() const { return summary_problem_; }
 
   // Walks the data section in file order. Never throws for a damaged file:
-  // the result says where and why it stopped. Exceptions from the callbacks pass.
+  // the result says where and why it stopped (a chunk over the limit, a chunk
+  // holding a record other than Schema, Channel and Message, ...). Besides
+  // the mapped file it holds one chunk as stored and its records: at most
+  // chunk_records_max bytes, 1.5 times that while their buffer doubles.
+  // Exceptions from the callbacks pass.
   ScanResult scan(const Visitor& visitor, bool verify_crcs = true) const;
 
   std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
@@ -84,6 +94,7 @@ class Reader {
   void read_summary();
 
   std::string path_;
+  ReaderOptions options_;
   const std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
   Header header_;

@@ -192,10 +192,19 @@ std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc = 0);
 enum class Compression { None, Zstd, Lz4 };
 std::string_view compression_name(Compression compression);  // "", "zstd", "lz4"
 std::vector<std::uint8_t> compress(Compression compression, std::span<const std::uint8_t> bytes);
-// Throws FormatError for an unknown compression or bytes that do not
-// decompress to exactly uncompressed_size bytes.
+
+// The most a chunk's records may take uncompressed, 1 GiB: a reader holds one
+// chunk's records at a time, so this bounds what reading any file costs,
+// whatever it declares. The writer keeps its chunks within it.
+inline constexpr std::uint64_t default_chunk_records_max = std::uint64_t{1} << 30;
+
+// Throws FormatError for an unknown compression, an uncompressed_size over
+// max_size (before decompressing anything) or bytes that do not decompress
+// to exactly uncompressed_size bytes. The output grows (doubling) only as
+// the codec produces bytes, never past the smaller of the two sizes.
 std::vector<std::uint8_t> decompress(std::string_view compression,
                                      std::span<const std::uint8_t> bytes,
-                                     std::uint64_t uncompressed_size);
+                                     std::uint64_t uncompressed_size,
+                                     std::uint64_t max_size = default_chunk_records_max);
 
 }  // namespace agnocast::mcap

@@ -17,6 +17,13 @@
 
 namespace agnocast::mcap {
 
+// A Message record's bytes besides its data: prefix, channel id, sequence, two times.
+inline constexpr std::uint64_t message_record_overhead = record_prefix_size + 2 + 4 + 8 + 8;
+// The most data one message may carry: its record alone fills a chunk of
+// default_chunk_records_max bytes, what readers accept.
+inline constexpr std::uint64_t message_data_max =
+    default_chunk_records_max - message_record_overhead;
+
 struct WriterOptions {
   std::string profile;
   std::string library = "agnocast";
@@ -38,6 +45,9 @@ class Writer {
   std::uint16_t add_schema(std::string name, std::string encoding, std::vector<std::uint8_t> data);
   std::uint16_t add_channel(std::uint16_t schema_id, std::string topic, std::string encoding,
                             StringMap metadata);
+  // A chunk never grows past default_chunk_records_max: the open one is
+  // written first when the message would not fit. Throws FormatError for data
+  // over message_data_max.
   void write_message(std::uint16_t channel_id, std::uint64_t log_time, std::uint64_t publish_time,
                      std::span<const std::uint8_t> data);
   void add_metadata(Metadata metadata);
@@ -54,6 +64,8 @@ class Writer {
 
  private:
   void flush_chunk();
+  // Appends a record to the open chunk, written first if the record would not fit in it.
+  void add_to_chunk(std::span<const std::uint8_t> record);
   void put(std::span<const std::uint8_t> bytes, bool data_section);
 
   std::string path_;

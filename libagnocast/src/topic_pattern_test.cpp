@@ -1,9 +1,9 @@
-#include "agnocast/access_policy.hpp"
-
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 #include <string>
+
+#include "agnocast/access_policy.hpp"
 
 namespace agnocast {
 namespace {

@@ -1,10 +1,11 @@
 # agnocast_add_bridge(<target> MESSAGES <message package>...)
 #
-# Builds an agnocast-bridge executable <target> that knows every message type
-# of the listed packages: targets made by agnocast_generate_messages(), or
-# packages of the standard set (std_msgs, sensor_msgs, ...: agnocast::<name>).
-# The bridge's source is not touched: this writes a main() and, per package, a
-# source that adds each type of the package's .msg folder to the bridge's type
+# Builds an agnocast-bridge executable <target> that knows every message and
+# service type of the listed packages: targets made by
+# agnocast_generate_messages(), or packages of the standard set (std_msgs,
+# sensor_msgs, std_srvs, ...: agnocast::<name>). The bridge's source is not
+# touched: this writes a main() and, per package, a source that adds each type
+# of the package's .msg folder and each of its .srv files to the bridge's type
 # registry.
 #
 #   agnocast_generate_messages(wheel_msgs PACKAGE wheel_msgs FILES msg/Wheel.msg
@@ -28,6 +29,7 @@ function(agnocast_add_bridge target)
   set(declarations "")
   set(calls "")
   set(message_targets "")
+  list(REMOVE_DUPLICATES arg_MESSAGES)
   foreach(messages IN LISTS arg_MESSAGES)
     if(TARGET ${messages})
       set(messages_target ${messages})
@@ -48,10 +50,18 @@ function(agnocast_add_bridge target)
         set(msg_dir "${CMAKE_MATCH_1}")
       endif()
     endforeach()
-    if(NOT msg_dir)
-      message(FATAL_ERROR "agnocast_add_bridge(${target}): no .msg folder for package ${package}")
+    get_target_property(srv_files ${messages_target} AGNOCAST_SRV_FILES)
+    if(NOT srv_files)
+      set(srv_files "")
     endif()
-    file(GLOB msg_files CONFIGURE_DEPENDS "${msg_dir}/*.msg")
+    if(NOT msg_dir AND NOT srv_files)
+      message(FATAL_ERROR "agnocast_add_bridge(${target}): no .msg folder or .srv file for "
+                          "package ${package}")
+    endif()
+    set(msg_files "")
+    if(msg_dir)
+      file(GLOB msg_files CONFIGURE_DEPENDS "${msg_dir}/*.msg")
+    endif()
     set(includes "")
     set(additions "")
     foreach(msg_file IN LISTS msg_files)
@@ -59,6 +69,12 @@ function(agnocast_add_bridge target)
       _agnocast_snake_case(${name} snake)
       string(APPEND includes "#include <${package}/msg/${snake}.hpp>\n")
       string(APPEND additions "  types.add<${package}::msg::${name}>();\n")
+    endforeach()
+    foreach(srv_file IN LISTS srv_files)
+      get_filename_component(name "${srv_file}" NAME_WE)
+      _agnocast_snake_case(${name} snake)
+      string(APPEND includes "#include <${package}/srv/${snake}.hpp>\n")
+      string(APPEND additions "  types.add_service<${package}::srv::${name}>();\n")
     endforeach()
     set(function "add_${package}_types")
     set(source ${CMAKE_CURRENT_BINARY_DIR}/${target}_${package}.cpp)

@@ -36,16 +36,25 @@ constexpr int exit_usage = 2;  // a bad command line or configuration
 // sample comes: it proves it is alive at least this often.
 constexpr auto receiver_turn = std::chrono::seconds(1);
 
-// Bridged topics whose type is not in the registry are configuration errors.
+// Bridged topics and services whose type is not in the registry are configuration errors.
 void check_types(const Config& config, const TypeRegistry& types) {
+  // The standard set alone has over a hundred types: named by --list-types, not here.
+  const std::string known = " (--list-types shows the " +
+                            std::to_string(types.type_names().size()) + " message and " +
+                            std::to_string(types.service_type_names().size()) +
+                            " service types it knows; a bridge for other types is built with "
+                            "agnocast_add_bridge())";
   for (std::size_t i = 0; i < config.topics.size(); ++i) {
     if (types.knows(config.topics[i].type)) continue;
-    // The standard set alone has over a hundred types: named by --list-types, not here.
-    throw ConfigError("topics[" + std::to_string(i) + "].type",
-                      "this bridge does not know the message type '" + config.topics[i].type +
-                          "' (--list-types shows the " + std::to_string(types.type_names().size()) +
-                          " it knows; a bridge for other types is built with "
-                          "agnocast_add_bridge())");
+    throw ConfigError(
+        "topics[" + std::to_string(i) + "].type",
+        "this bridge does not know the message type '" + config.topics[i].type + "'" + known);
+  }
+  for (std::size_t i = 0; i < config.services.size(); ++i) {
+    if (types.knows_service(config.services[i].type)) continue;
+    throw ConfigError(
+        "services[" + std::to_string(i) + "].type",
+        "this bridge does not know the service type '" + config.services[i].type + "'" + known);
   }
 }
 
@@ -55,17 +64,24 @@ struct BridgedTopic {
   std::unique_ptr<Relay> relay;
 };
 
-// Waits for DDS samples on every from_dds reader and relays them, on its own thread.
+struct BridgedService {
+  const ServiceConfig* config;
+  std::unique_ptr<TopicCounters> counters;
+  std::unique_ptr<Relay> relay;
+};
+
+// Waits for DDS samples on every DDS reader (from_dds topics', services' both
+// ways) and relays them, on its own thread.
 class DdsReceiver {
  public:
-  DdsReceiver(const DdsDomain& domain, const std::vector<BridgedTopic>& topics)
+  DdsReceiver(const DdsDomain& domain, const std::vector<Relay*>& relays)
       : waitset_(check_dds(dds_create_waitset(domain.participant()), "DDS waitset")),
         stop_(check_dds(dds_create_guardcondition(domain.participant()), "DDS guard condition")) {
     check_dds(dds_waitset_attach(waitset_.get(), stop_.get(), 0), "DDS waitset");
-    for (std::size_t i = 0; i < topics.size(); ++i) {
-      if (topics[i].relay->reader() == 0) continue;
-      relays_.push_back(topics[i].relay.get());
-      check_dds(dds_waitset_attach(waitset_.get(), topics[i].relay->reader(),
+    for (Relay* relay : relays) {
+      if (relay->reader() == 0) continue;
+      relays_.push_back(relay);
+      check_dds(dds_waitset_attach(waitset_.get(), relay->reader(),
                                    static_cast<dds_attach_t>(relays_.size())),
                 "DDS waitset");
     }
@@ -138,7 +154,8 @@ std::uint64_t lost_on_agnocast_side(const TopicConfig& topic, std::uint32_t subs
   return 0;
 }
 
-BridgeStatus collect_status(const Config& config, const std::vector<BridgedTopic>& topics) {
+BridgeStatus collect_status(const Config& config, const std::vector<BridgedTopic>& topics,
+                            const std::vector<BridgedService>& services) {
   BridgeStatus status;
   status.domain_id = config.domain_id;
   for (const auto& topic : topics) {
@@ -148,6 +165,11 @@ BridgeStatus collect_status(const Config& config, const std::vector<BridgedTopic
                          ? lost_on_agnocast_side(*topic.config, topic.relay->subscription_id())
                          : lost_on_dds_side(topic.relay->reader());
     status.topics.push_back(entry);
+  }
+  for (const auto& service : services) {
+    status.services.push_back(BridgedServiceStatus{service.config, service.counters->relayed,
+                                                   service.counters->dropped,
+                                                   service.counters->errors});
   }
   return status;
 }
@@ -177,12 +199,33 @@ int serve(const Config& config, const TypeRegistry& types) {
     }
   }
 
+  std::vector<BridgedService> services;
+  for (std::size_t i = 0; i < config.services.size(); ++i) {
+    const ServiceConfig& service = config.services[i];
+    auto counters = std::make_unique<TopicCounters>();
+    const ServiceRelayContext context{service, node, domain, *counters};
+    try {
+      auto relay = types.make_service(service.type, service.direction, context);
+      services.push_back(BridgedService{&service, std::move(counters), std::move(relay)});
+    } catch (const std::invalid_argument& error) {
+      throw ConfigError("services[" + std::to_string(i) + "]", error.what());
+    } catch (const std::exception& error) {
+      // ServiceExists (from_dds: another server has the name) and the like.
+      throw std::runtime_error("service " + service.name + " (" +
+                               std::string(direction_name(service.direction)) +
+                               "): " + error.what());
+    }
+  }
+  std::vector<Relay*> relays;
+  for (const auto& topic : topics) relays.push_back(topic.relay.get());
+  for (const auto& service : services) relays.push_back(service.relay.get());
+
   // One loop: agnocast's subscriptions and the service's descriptor (signals,
   // the status file's timer, the watchdog's); DDS samples come on the
   // receiver's thread.
   agnocast::SingleThreadedExecutor executor;
   executor.add_node(node);
-  const DdsReceiver receiver(domain, topics);
+  const DdsReceiver receiver(domain, relays);
   executor.add_fd(service.fd(), [&service, &executor] {
     if (!service.dispatch()) executor.cancel();
   });
@@ -191,18 +234,19 @@ int serve(const Config& config, const TypeRegistry& types) {
       agnocast_service::watchdog_ping_interval().value_or(std::chrono::microseconds{0}),
       2 * receiver_turn);
   agnocast_service::ServiceHooks hooks;
-  hooks.status_body = [&config, &topics](const agnocast::ServiceStatus&) {
-    return status_body(collect_status(config, topics));
+  hooks.status_body = [&config, &topics, &services](const agnocast::ServiceStatus&) {
+    return status_body(collect_status(config, topics, services));
   };
   hooks.healthy = [&receiver, receiver_limit] {
     const bool alive = receiver.alive(receiver_limit);
     if (!alive) spdlog::error("the DDS receiver is stuck; not pinging the watchdog");
     return alive;
   };
-  spdlog::info("relaying {} topic(s) on DDS domain {}", topics.size(), config.domain_id);
-  service.ready("relaying " + std::to_string(topics.size()) + " topic(s) on DDS domain " +
-                    std::to_string(config.domain_id),
-                std::move(hooks));
+  const std::string relaying = "relaying " + std::to_string(topics.size()) + " topic(s) and " +
+                               std::to_string(services.size()) + " service(s) on DDS domain " +
+                               std::to_string(config.domain_id);
+  spdlog::info("{}", relaying);
+  service.ready(relaying, std::move(hooks));
   executor.spin();
   executor.remove_fd(service.fd());
   service.stopped();
@@ -220,7 +264,7 @@ int run_bridge(int argc, char** argv, const TypeRegistry& types) {
   app.add_option("--config", config_path, "Configuration file")->capture_default_str();
   app.add_flag("--check-config", check_only,
                "Validate the configuration and exit (0 valid, 2 not)");
-  app.add_flag("--list-types", list_types, "Print the message types this bridge knows");
+  app.add_flag("--list-types", list_types, "Print the message and service types this bridge knows");
   app.set_version_flag("--version",
                        "agnocast-bridge " + std::string(agnocast::library_version_string));
   try {
@@ -230,6 +274,7 @@ int run_bridge(int argc, char** argv, const TypeRegistry& types) {
   }
   if (list_types) {
     for (const auto& name : types.type_names()) std::cout << name << '\n';
+    for (const auto& name : types.service_type_names()) std::cout << name << '\n';
     return EXIT_SUCCESS;
   }
 
@@ -245,7 +290,7 @@ int run_bridge(int argc, char** argv, const TypeRegistry& types) {
   }
   if (check_only) {
     std::cout << "agnocast-bridge: " << config_path << " is valid (" << config.topics.size()
-              << " topic(s))\n";
+              << " topic(s), " << config.services.size() << " service(s))\n";
     return EXIT_SUCCESS;
   }
   try {

@@ -17,6 +17,9 @@ using nlohmann::json;
 
 // DDS maps domain ids to UDP ports; 232 is the largest the default mapping allows.
 constexpr std::uint32_t max_domain_id = 232;
+// A bridged DDS call may take at most this long (ten minutes): an agnocast
+// request pending longer is a hung request, not a slow one.
+constexpr std::uint64_t max_service_timeout_ms = 600'000;
 // Every other bound is the library's (<agnocast/limits.hpp>): what the
 // configuration check accepts, the library accepts when the bridge starts.
 
@@ -69,6 +72,14 @@ TopicQos parse_qos(const json& object, const std::string& where) {
   return qos;
 }
 
+Direction parse_direction(const json& object, const std::string& where) {
+  const std::string direction = require_string(object, where, "direction");
+  if (direction == "to_dds") return Direction::to_dds;
+  if (direction == "from_dds") return Direction::from_dds;
+  throw ConfigError(where + ".direction",
+                    "must be \"to_dds\" or \"from_dds\", not \"" + direction + "\"");
+}
+
 TopicConfig parse_topic(const json& object, const std::string& where) {
   if (!object.is_object()) throw ConfigError(where, "must be an object");
   refuse_unknown_keys(object, where, {"name", "type", "direction", "qos"});
@@ -88,19 +99,70 @@ TopicConfig parse_topic(const json& object, const std::string& where) {
   } catch (const std::invalid_argument& error) {
     throw ConfigError(where + ".type", error.what());
   }
-  const std::string direction = require_string(object, where, "direction");
-  if (direction == "to_dds") {
-    topic.direction = Direction::to_dds;
-  } else if (direction == "from_dds") {
-    topic.direction = Direction::from_dds;
-  } else {
-    throw ConfigError(where + ".direction",
-                      "must be \"to_dds\" or \"from_dds\", not \"" + direction + "\"");
-  }
+  topic.direction = parse_direction(object, where);
   if (const auto qos = object.find("qos"); qos != object.end()) {
     topic.qos = parse_qos(*qos, where + ".qos");
   }
   return topic;
+}
+
+ServiceConfig parse_service(const json& object, const std::string& where) {
+  if (!object.is_object()) throw ConfigError(where, "must be an object");
+  refuse_unknown_keys(object, where, {"name", "type", "direction", "timeout_ms"});
+  ServiceConfig service;
+  service.name = require_string(object, where, "name");
+  if (const std::string problem = agnocast::service_name_problem(service.name); !problem.empty()) {
+    throw ConfigError(where + ".name", problem);
+  }
+  service.type = require_string(object, where, "type");
+  // The request and response types are named after the service type, and
+  // the longer one must fit the library's bound.
+  constexpr std::string_view longer_part = "_Response";
+  if (service.type.size() + longer_part.size() > agnocast::type_name_max) {
+    throw ConfigError(where + ".type",
+                      "service type name '" + service.type + "' is too long: at most " +
+                          std::to_string(agnocast::type_name_max - longer_part.size()) +
+                          " characters");
+  }
+  try {
+    dds_service_type_names(service.type);
+  } catch (const std::invalid_argument& error) {
+    throw ConfigError(where + ".type", error.what());
+  }
+  service.direction = parse_direction(object, where);
+  if (const auto timeout = object.find("timeout_ms"); timeout != object.end()) {
+    if (service.direction != Direction::from_dds) {
+      throw ConfigError(where + ".timeout_ms",
+                        "only a from_dds service waits for DDS: to_dds waits for agnocast");
+    }
+    if (!timeout->is_number_unsigned() || timeout->get<std::uint64_t>() < 1 ||
+        timeout->get<std::uint64_t>() > max_service_timeout_ms) {
+      throw ConfigError(where + ".timeout_ms",
+                        "must be an integer from 1 to " + std::to_string(max_service_timeout_ms));
+    }
+    service.timeout = std::chrono::milliseconds(timeout->get<std::uint64_t>());
+  }
+  return service;
+}
+
+std::vector<ServiceConfig> parse_services(const json& document) {
+  std::vector<ServiceConfig> services;
+  const auto list = document.find("services");
+  if (list == document.end()) return services;
+  if (!list->is_array()) throw ConfigError("services", "must be an array");
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const std::string where = "services[" + std::to_string(i) + "]";
+    ServiceConfig service = parse_service((*list)[i], where);
+    // Both ways would make the bridge the agnocast server of the name and its own client.
+    if (!seen.insert(service.name).second) {
+      throw ConfigError(where + ".name", "service " + service.name +
+                                             " is already bridged; a service is bridged "
+                                             "one way, where its server is");
+    }
+    services.push_back(std::move(service));
+  }
+  return services;
 }
 
 }  // namespace
@@ -117,7 +179,7 @@ Config parse_config(std::string_view json_text) {
     throw ConfigError("", std::string("not valid JSON: ") + error.what());
   }
   if (!document.is_object()) throw ConfigError("", "the configuration must be a JSON object");
-  refuse_unknown_keys(document, "", {"domain_id", "topics"});
+  refuse_unknown_keys(document, "", {"domain_id", "topics", "services"});
 
   Config config;
   if (const auto domain = document.find("domain_id"); domain != document.end()) {
@@ -127,8 +189,13 @@ Config parse_config(std::string_view json_text) {
     }
     config.domain_id = domain->get<std::uint32_t>();
   }
-  const auto topics = document.find("topics");
-  if (topics == document.end()) throw ConfigError("topics", "missing");
+  // Topics, services or both; without either a bridge has nothing to do.
+  const json no_topics = json::array();
+  auto found = document.find("topics");
+  if (found == document.end() && !document.contains("services")) {
+    throw ConfigError("topics", "missing");
+  }
+  const json* topics = found != document.end() ? &*found : &no_topics;
   if (!topics->is_array()) throw ConfigError("topics", "must be an array");
   std::set<std::pair<std::string, Direction>> seen;
   for (std::size_t i = 0; i < topics->size(); ++i) {
@@ -151,6 +218,7 @@ Config parse_config(std::string_view json_text) {
       }
     }
   }
+  config.services = parse_services(document);
   return config;
 }
 

@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
 
 #include "agnocast/limits.hpp"
+#include "agnocast/naming.hpp"
 
 namespace agnocast_bridge {
 namespace {
@@ -113,6 +115,101 @@ TEST(Config, TypeNameLengthIsTheLibrarys) {
   const std::string longest = "p/msg/" + std::string(agnocast::type_name_max - 6, 'T');
   EXPECT_EQ(parse_config(config_with_type(longest)).topics[0].type, longest);
   EXPECT_EQ(error_key(config_with_type(longest + "T")), "topics[0].type");
+}
+
+TEST(Config, ServicesParse) {
+  const Config config = parse_config(R"({"services": [
+    {"name": "/add_two_ints", "type": "example_interfaces/srv/AddTwoInts", "direction": "from_dds",
+     "timeout_ms": 250},
+    {"name": "/arm/enable", "type": "std_srvs/srv/SetBool", "direction": "to_dds"}]})");
+  EXPECT_TRUE(config.topics.empty());
+  ASSERT_EQ(config.services.size(), 2u);
+  EXPECT_EQ(config.services[0].name, "/add_two_ints");
+  EXPECT_EQ(config.services[0].type, "example_interfaces/srv/AddTwoInts");
+  EXPECT_EQ(config.services[0].direction, Direction::from_dds);
+  EXPECT_EQ(config.services[0].timeout, std::chrono::milliseconds(250));
+  EXPECT_EQ(config.services[1].direction, Direction::to_dds);
+  EXPECT_EQ(config.services[1].timeout, std::chrono::milliseconds(5000));
+}
+
+std::string with_service(const std::string& fields) {
+  return R"({"topics": [], "services": [{"name": "/s", "type": "std_srvs/srv/Empty",
+             "direction": "from_dds"}, {)" +
+         fields + "}]}";
+}
+
+TEST(Config, ServiceErrorsNameTheKey) {
+  const std::string service = R"("name": "/s2", "type": "std_srvs/srv/Trigger")";
+  EXPECT_EQ(error_key(R"({"services": {}})"), "services");
+  EXPECT_EQ(error_key(R"({"services": [1]})"), "services[0]");
+  EXPECT_EQ(error_key(R"({"services": [null]})"), "services[0]");
+  EXPECT_EQ(error_key(with_service("")), "services[1].name");
+  EXPECT_EQ(error_key(with_service(service)), "services[1].direction");
+  EXPECT_EQ(error_key(with_service(service + R"(, "direction": "both")")), "services[1].direction");
+  EXPECT_EQ(error_key(with_service(service + R"(, "direction": 1)")), "services[1].direction");
+  EXPECT_EQ(error_key(with_service(service + R"(, "direction": "to_dds", "qos": {})")),
+            "services[1].qos");
+  EXPECT_EQ(error_key(with_service(R"("name": 7, "type": "std_srvs/srv/Empty")")),
+            "services[1].name");
+  // The library's service name rules.
+  for (const std::string& name :
+       {std::string("s"), std::string("/a b"), std::string("/a//b"), std::string("/"),
+        std::string("/_service_request/x"), std::string("/a/"),
+        "/" + std::string(agnocast::service_name_max, 'n'), std::string("/\\u00e9"),
+        std::string("/a\\u0000b")}) {
+    EXPECT_EQ(error_key(with_service(R"("name": ")" + name +
+                                     R"(", "type": "std_srvs/srv/Empty", "direction": "to_dds")")),
+              "services[1].name")
+        << name;
+  }
+  for (const std::string& type :
+       {std::string("std_srvs/msg/Empty"), std::string("Empty"), std::string("std_srvs/srv/"),
+        std::string("/srv/Empty"), std::string("a/srv/b/c"), std::string(""),
+        "p/srv/" + std::string(agnocast::type_name_max, 'T')}) {
+    EXPECT_EQ(error_key(with_service(R"("name": "/s2", "direction": "to_dds", "type": ")" + type +
+                                     R"(")")),
+              "services[1].type")
+        << type;
+  }
+  // One way only: both would make the bridge the name's server and its own client.
+  EXPECT_EQ(error_key(with_service(
+                R"("name": "/s", "type": "std_srvs/srv/Empty", "direction": "to_dds")")),
+            "services[1].name");
+}
+
+TEST(Config, ServiceTimeoutIsBounded) {
+  const std::string service = R"("name": "/s2", "type": "std_srvs/srv/Trigger")";
+  EXPECT_EQ(parse_config(with_service(service + R"(, "direction": "from_dds", "timeout_ms": 1)"))
+                .services[1]
+                .timeout,
+            std::chrono::milliseconds(1));
+  EXPECT_EQ(
+      parse_config(with_service(service + R"(, "direction": "from_dds", "timeout_ms": 600000)"))
+          .services[1]
+          .timeout,
+      std::chrono::minutes(10));
+  for (const std::string& timeout :
+       {std::string("0"), std::string("600001"), std::string("-5"), std::string("1.5"),
+        std::string("\"100\""), std::string("null"), std::string("1e30"),
+        std::string("18446744073709551615")}) {
+    EXPECT_EQ(
+        error_key(with_service(service + R"(, "direction": "from_dds", "timeout_ms": )" + timeout)),
+        "services[1].timeout_ms")
+        << timeout;
+  }
+  // A to_dds service waits for an agnocast server, which fails its own requests.
+  EXPECT_EQ(error_key(with_service(service + R"(, "direction": "to_dds", "timeout_ms": 100)")),
+            "services[1].timeout_ms");
+}
+
+TEST(Config, ServiceTypeNameLengthLeavesRoomForItsParts) {
+  const auto config_with_type = [](const std::string& type) {
+    return R"({"services": [{"name": "/s", "direction": "to_dds", "type": ")" + type + R"("}]})";
+  };
+  // "p/srv/", a name, and "_Response" make up the longest type the library takes.
+  const std::string longest = "p/srv/" + std::string(agnocast::type_name_max - 6 - 9, 'T');
+  EXPECT_EQ(parse_config(config_with_type(longest)).services[0].type, longest);
+  EXPECT_EQ(error_key(config_with_type(longest + "T")), "services[0].type");
 }
 
 TEST(Config, MissingFileIsAConfigError) {

@@ -2,6 +2,7 @@
 
 #include <dds/ddsi/ddsi_sertype.h>
 
+#include <cstring>
 #include <memory>
 
 #include "cdr_sertype.hpp"
@@ -19,8 +20,9 @@ using QosPointer = std::unique_ptr<dds_qos_t, QosDeleter>;
 // counts as dropped (the agnocast side then moves on to the next message).
 constexpr dds_duration_t reliable_max_blocking = DDS_SECS(1);
 
-QosPointer endpoint_qos(const TopicQos& topic_qos) {
+QosPointer endpoint_qos(const TopicQos& topic_qos, const std::string& user_data) {
   QosPointer qos(dds_create_qos());
+  if (!user_data.empty()) dds_qset_userdata(qos.get(), user_data.data(), user_data.size());
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, static_cast<int32_t>(topic_qos.depth));
   if (topic_qos.reliable) {
     dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, reliable_max_blocking);
@@ -68,8 +70,11 @@ DdsDomain::DdsDomain(std::uint32_t domain_id) : domain_id_(domain_id) {
 }
 
 DdsTopic DdsDomain::create_topic(const TopicConfig& topic) {
-  ddsi_sertype* sertype = make_cdr_sertype(dds_type_name(topic.type));
-  const std::string name = dds_topic_name(topic.name);
+  return create_topic(dds_topic_name(topic.name), dds_type_name(topic.type));
+}
+
+DdsTopic DdsDomain::create_topic(const std::string& name, const std::string& dds_type) {
+  ddsi_sertype* sertype = make_cdr_sertype(dds_type);
   const dds_entity_t handle =
       dds_create_topic_sertype(participant(), name.c_str(), &sertype, nullptr, nullptr, nullptr);
   if (handle < 0) {
@@ -79,17 +84,29 @@ DdsTopic DdsDomain::create_topic(const TopicConfig& topic) {
   return DdsTopic{DdsEntity(handle), sertype};
 }
 
-DdsEntity DdsDomain::create_writer(dds_entity_t topic, const TopicQos& topic_qos) {
-  const QosPointer qos = endpoint_qos(topic_qos);
+DdsEntity DdsDomain::create_writer(dds_entity_t topic, const TopicQos& topic_qos,
+                                   const std::string& user_data) {
+  const QosPointer qos = endpoint_qos(topic_qos, user_data);
   return DdsEntity(
       check_dds(dds_create_writer(participant(), topic, qos.get(), nullptr), "DDS writer"));
 }
 
-DdsEntity DdsDomain::create_reader(dds_entity_t topic, const TopicQos& topic_qos) {
-  const QosPointer qos = endpoint_qos(topic_qos);
+DdsEntity DdsDomain::create_reader(dds_entity_t topic, const TopicQos& topic_qos,
+                                   const std::string& user_data) {
+  const QosPointer qos = endpoint_qos(topic_qos, user_data);
   dds_qset_ignorelocal(qos.get(), DDS_IGNORELOCAL_PARTICIPANT);
   return DdsEntity(
       check_dds(dds_create_reader(participant(), topic, qos.get(), nullptr), "DDS reader"));
+}
+
+std::array<std::uint8_t, 16> DdsDomain::new_service_endpoint_id() {
+  dds_guid_t guid{};
+  check_dds(dds_get_guid(participant(), &guid), "DDS participant GUID");
+  std::array<std::uint8_t, 16> id{};
+  std::memcpy(id.data(), guid.v, 12);
+  const std::uint32_t count = ++service_endpoints_;
+  for (std::size_t i = 0; i < 4; ++i) id[12 + i] = static_cast<std::uint8_t>(count >> (24 - 8 * i));
+  return id;
 }
 
 }  // namespace agnocast_bridge

@@ -4,6 +4,7 @@
 
 #include <dds/dds.h>
 
+#include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -56,14 +57,23 @@ class DdsDomain {
 
   // A ROS 2 compatible topic ("rt/...", "pkg::msg::dds_::Type_") of XCDR1 bytes.
   DdsTopic create_topic(const TopicConfig& topic);
-  DdsEntity create_writer(dds_entity_t topic, const TopicQos& qos);
+  // A topic of XCDR1 bytes named as given ("rq/...Request", "pkg::srv::dds_::Name_Request_").
+  DdsTopic create_topic(const std::string& dds_name, const std::string& dds_type);
+  // user_data, when not empty, goes in the endpoint's USER_DATA QoS.
+  DdsEntity create_writer(dds_entity_t topic, const TopicQos& qos,
+                          const std::string& user_data = {});
   // Ignores the samples of this participant's own writers: a topic bridged both
   // ways does not read back what the bridge wrote.
-  DdsEntity create_reader(dds_entity_t topic, const TopicQos& qos);
+  DdsEntity create_reader(dds_entity_t topic, const TopicQos& qos,
+                          const std::string& user_data = {});
+  // A new id for a service's (or a client's) reader and writer pair, as
+  // rmw_cyclonedds_cpp makes them: the participant's GUID prefix and a counter.
+  std::array<std::uint8_t, 16> new_service_endpoint_id();
 
  private:
   std::uint32_t domain_id_;
   DdsEntity participant_;
+  std::uint32_t service_endpoints_ = 0;
 };
 
 // Throws DdsError with what, Cyclone's text for code, when code is negative.

@@ -24,5 +24,23 @@ TEST(DdsNames, MalformedTypeIsRefused) {
   }
 }
 
+TEST(DdsNames, ServiceFollowsRmwCycloneDds) {
+  const DdsServiceTopics topics = dds_service_topic_names("/arm/enable");
+  EXPECT_EQ(topics.request, "rq/arm/enableRequest");
+  EXPECT_EQ(topics.reply, "rr/arm/enableReply");
+  const ServiceTypeNames types = dds_service_type_names("example_interfaces/srv/AddTwoInts");
+  EXPECT_EQ(types.request, "example_interfaces/srv/AddTwoInts_Request");
+  EXPECT_EQ(types.response, "example_interfaces/srv/AddTwoInts_Response");
+  EXPECT_EQ(types.dds_request, "example_interfaces::srv::dds_::AddTwoInts_Request_");
+  EXPECT_EQ(types.dds_response, "example_interfaces::srv::dds_::AddTwoInts_Response_");
+}
+
+TEST(DdsNames, MalformedServiceTypeIsRefused) {
+  for (const char* bad : {"AddTwoInts", "std_srvs/msg/SetBool", "std_srvs/srv/", "/srv/SetBool",
+                          "a/srv/b/c", "std_srvs/srvX/SetBool"}) {
+    EXPECT_THROW(dds_service_type_names(bad), std::invalid_argument) << bad;
+  }
+}
+
 }  // namespace
 }  // namespace agnocast_bridge

@@ -48,6 +48,27 @@ struct RelayContext {
   TopicCounters& counters;
 };
 
+// Takes every sample waiting on reader and hands each valid one's bytes to
+// handle; a failed take counts as an error.
+template <class Handle>
+void take_cdr_samples(dds_entity_t reader, TopicCounters& counters, Handle&& handle) {
+  constexpr std::uint32_t batch = 16;
+  std::array<ddsi_serdata*, batch> samples{};
+  std::array<dds_sample_info_t, batch> infos{};
+  for (;;) {
+    const dds_return_t taken =
+        dds_takecdr(reader, samples.data(), batch, infos.data(), DDS_ANY_STATE);
+    if (taken <= 0) {
+      if (taken < 0) ++counters.errors;
+      return;
+    }
+    for (dds_return_t i = 0; i < taken; ++i) {
+      if (infos[i].valid_data) handle(cdr_serdata_bytes(samples[i]));
+      release_serdata(samples[i]);
+    }
+  }
+}
+
 template <class T>
 class ToDds : public Relay {
  public:
@@ -108,21 +129,8 @@ class FromDds : public Relay {
   dds_entity_t reader() const override { return reader_.get(); }
 
   void relay_available() override {
-    constexpr std::uint32_t batch = 16;
-    std::array<ddsi_serdata*, batch> samples{};
-    std::array<dds_sample_info_t, batch> infos{};
-    for (;;) {
-      const dds_return_t taken =
-          dds_takecdr(reader_.get(), samples.data(), batch, infos.data(), DDS_ANY_STATE);
-      if (taken <= 0) {
-        if (taken < 0) ++counters_.errors;
-        return;
-      }
-      for (dds_return_t i = 0; i < taken; ++i) {
-        if (infos[i].valid_data) relay(cdr_serdata_bytes(samples[i]));
-        release_serdata(samples[i]);
-      }
-    }
+    take_cdr_samples(reader_.get(), counters_,
+                     [this](std::span<const std::uint8_t> bytes) { relay(bytes); });
   }
 
  private:

@@ -15,7 +15,7 @@ namespace {
 TEST(StatusFile, CountersPerTopicAsJson) {
   TopicConfig points{"/points", "sensor_msgs/msg/PointCloud2", Direction::to_dds, {}};
   TopicConfig cmd{"/cmd_vel", "geometry_msgs/msg/Twist", Direction::from_dds, {}};
-  BridgeStatus status{7, {{&points, 10, 1, 2}, {&cmd, 3, 0, 0}}};
+  BridgeStatus status{7, {{&points, 10, 1, 2}, {&cmd, 3, 0, 0}}, {}};
   const agnocast::ServiceStatus head{
       "agnocast-bridge", 42, "0.1.0", agnocast::ServiceState::running, 1700000000, 5, 1700000005};
 
@@ -44,6 +44,24 @@ TEST(StatusFile, CountersPerTopicAsJson) {
   EXPECT_EQ(first["errors"], 2);
   EXPECT_EQ(json["topics"][1]["direction"], "from_dds");
   EXPECT_EQ(json["topics"][1]["relayed"], 3);
+}
+
+TEST(StatusFile, CountersPerServiceAsJson) {
+  ServiceConfig add{"/add_two_ints", "example_interfaces/srv/AddTwoInts", Direction::from_dds, {}};
+  const BridgeStatus status{0, {}, {{&add, 3, 1, 0}}};
+  const auto json = status_body(status);
+  ASSERT_EQ(json["services"].size(), 1u);
+  const auto& service = json["services"][0];
+  EXPECT_EQ(service["name"], "/add_two_ints");
+  EXPECT_EQ(service["type"], "example_interfaces/srv/AddTwoInts");
+  EXPECT_EQ(service["direction"], "from_dds");
+  EXPECT_EQ(service["dds_request_topic"], "rq/add_two_intsRequest");
+  EXPECT_EQ(service["dds_reply_topic"], "rr/add_two_intsReply");
+  EXPECT_EQ(service["dds_request_type"], "example_interfaces::srv::dds_::AddTwoInts_Request_");
+  EXPECT_EQ(service["dds_response_type"], "example_interfaces::srv::dds_::AddTwoInts_Response_");
+  EXPECT_EQ(service["relayed"], 3);
+  EXPECT_EQ(service["dropped"], 1);
+  EXPECT_EQ(service["errors"], 0);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
-// The message types a bridge binary knows, by ROS 2 type name. The standard
-// set is added by the agnocast-bridge binary; agnocast_add_bridge() (CMake)
-// builds a bridge that adds a user's generated packages as well.
+// The message and service types a bridge binary knows, by ROS 2 type name.
+// The standard set is added by the agnocast-bridge binary;
+// agnocast_add_bridge() (CMake) builds a bridge that adds a user's generated
+// packages as well.
 #pragma once
 
 #include <functional>
@@ -11,7 +12,9 @@
 #include <vector>
 
 #include "agnocast/message_traits.hpp"
+#include "agnocast/service_traits.hpp"
 #include "relay.hpp"
+#include "service_relay.hpp"
 
 namespace agnocast_bridge {
 
@@ -30,18 +33,42 @@ class TypeRegistry {
                            }};
   }
 
+  template <agnocast::ServiceType Srv>
+  void add_service() {
+    const std::string name(agnocast::service_traits<Srv>::type_name);
+    services_[name] =
+        ServiceEntry{[](const ServiceRelayContext& context) -> std::unique_ptr<Relay> {
+                       return std::make_unique<ServiceToDds<Srv>>(context);
+                     },
+                     [](const ServiceRelayContext& context) -> std::unique_ptr<Relay> {
+                       return std::make_unique<ServiceFromDds<Srv>>(context);
+                     }};
+  }
+
   bool knows(std::string_view type_name) const;
   // Throws std::out_of_range for a type it does not know.
   std::unique_ptr<Relay> make(std::string_view type_name, Direction direction,
                               const RelayContext& context) const;
   std::vector<std::string> type_names() const;
 
+  bool knows_service(std::string_view type_name) const;
+  // Throws std::out_of_range for a service type it does not know.
+  std::unique_ptr<Relay> make_service(std::string_view type_name, Direction direction,
+                                      const ServiceRelayContext& context) const;
+  std::vector<std::string> service_type_names() const;
+
  private:
+  using MakeServiceRelay = std::function<std::unique_ptr<Relay>(const ServiceRelayContext&)>;
   struct Entry {
     MakeRelay to_dds;
     MakeRelay from_dds;
   };
+  struct ServiceEntry {
+    MakeServiceRelay to_dds;
+    MakeServiceRelay from_dds;
+  };
   std::map<std::string, Entry, std::less<>> entries_;
+  std::map<std::string, ServiceEntry, std::less<>> services_;
 };
 
 }  // namespace agnocast_bridge

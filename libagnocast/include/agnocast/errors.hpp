@@ -67,7 +67,8 @@ class ServiceExists : public Error {
 };
 
 // A request will not be answered: no server was there, or it went away (its
-// process died, or its Service was destroyed) with the request pending.
+// process died, or its Service was destroyed) with the request pending, or
+// the server said it cannot answer it (Service::fail_request).
 class ServiceUnavailable : public Error {
  public:
   using Error::Error;

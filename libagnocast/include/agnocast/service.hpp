@@ -78,6 +78,11 @@ class Service : public detail::ServiceCore, public std::enable_shared_from_this<
     ServiceCore::send_response(id, loaned, detail::published_bytes(loaned, sizeof(Response)));
   }
 
+  // Answers the request with a failure instead of a response: the client's
+  // future throws ServiceUnavailable. For a server that cannot answer (a
+  // bridge whose far side did not in time).
+  void fail_request(const RequestId& id) { ServiceCore::fail_request(id); }
+
   const std::string& get_service_name() const { return service_name(); }
 
  private:

@@ -328,7 +328,8 @@ void ClientCore::deliver(const void* message, EntryReference* reference, const M
     std::lock_guard lock(state.mutex);
     const auto it = state.pending.find(tag.sequence);
     // Only the server the request went to may answer it.
-    if (tag.status == static_cast<std::uint16_t>(ServiceStatus::response) &&
+    if ((tag.status == static_cast<std::uint16_t>(ServiceStatus::response) ||
+         tag.status == static_cast<std::uint16_t>(ServiceStatus::failed)) &&
         it != state.pending.end() && it->second.server == info.publisher_id) {
       answered = std::move(it->second);
       state.pending.erase(it);
@@ -336,6 +337,13 @@ void ClientCore::deliver(const void* message, EntryReference* reference, const M
   }
   if (!answered) {
     release(reference);  // an answer to a pruned request
+    return;
+  }
+  if (tag.status == static_cast<std::uint16_t>(ServiceStatus::failed)) {
+    release(reference);
+    answered->completion(nullptr, nullptr,
+                         std::make_exception_ptr(ServiceUnavailable(
+                             "agnocast: service " + state.name + ": the server could not answer")));
     return;
   }
   answered->completion(message, reference, nullptr);

@@ -155,9 +155,18 @@ void ServiceCore::deliver(const void* message, EntryReference* reference, const 
 }
 
 void ServiceCore::send_response(const RequestId& id, void* response, std::size_t bytes) {
+  send_reply(id, response, bytes, ServiceStatus::response);
+}
+
+void ServiceCore::fail_request(const RequestId& id) {
+  send_reply(id, state_->empty_response(), 0, ServiceStatus::failed);
+}
+
+void ServiceCore::send_reply(const RequestId& id, void* response, std::size_t bytes,
+                             ServiceStatus status) {
   State& state = *state_;
-  set_service_tag(response, ServiceTag{id.sequence, state.replies.id(), 0,
-                                       static_cast<std::uint16_t>(ServiceStatus::response)});
+  set_service_tag(
+      response, ServiceTag{id.sequence, state.replies.id(), 0, static_cast<std::uint16_t>(status)});
   try {
     state.replies.publish(response, bytes, ServiceRoute{id.client, true});
   } catch (const DeviceError& error) {

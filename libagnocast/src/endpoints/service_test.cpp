@@ -278,6 +278,29 @@ TEST_F(ServiceTest, DeferredResponsesAnswerTheRightRequestsInAnyOrder) {
   for (int i = 0; i < 3; ++i) EXPECT_EQ(futures[i].get()->sum, 10 + i);
 }
 
+TEST_F(ServiceTest, AFailedRequestFailsItsFutureAloneAndLeavesNothingPending) {
+  Node node{"failing"};
+  const std::string name = topic("failing");
+  std::vector<RequestId> kept;
+  auto server = node.create_service<Add>(
+      name, [&](std::shared_ptr<Service<Add>>, RequestId id, ipc_shared_ptr<const Add::Request>) {
+        kept.push_back(id);
+      });
+  auto client = node.create_client<Add>(name);
+  Future failed = send(*client, 1, 2);
+  Future answered = send(*client, 3, 4);
+  EXPECT_EQ(server->handle_wakeup(), 2U);
+  ASSERT_EQ(kept.size(), 2U);
+  server->fail_request(kept[0]);
+  auto response = server->borrow_loaned_response();
+  response->sum = 7;
+  server->send_response(kept[1], std::move(response));
+  EXPECT_EQ(client->handle_wakeup(), 2U);
+  EXPECT_THROW(failed.get(), ServiceUnavailable);
+  EXPECT_EQ(answered.get()->sum, 7);
+  EXPECT_EQ(client->pending(), 0U);
+}
+
 TEST_F(ServiceTest, AResponseToAClientThatIsGoneIsCountedNotThrown) {
   Node node{"gone"};
   const std::string name = topic("gone_client");

@@ -29,6 +29,8 @@ enum class ServiceStatus : std::uint16_t {
   response = 2,
   // Sent to every client by a server that stops: what it has not answered never will be.
   server_gone = 3,
+  // Sent to one client instead of a response: the server cannot answer this request.
+  failed = 4,
 };
 
 // Placed right before every loaned message, in the publisher's own pool.

@@ -47,6 +47,10 @@ class ServiceCore : public SubscriptionBase {
   // asked. A client that is gone, or whose reply queue is full, does not get
   // it (counted in failures(), never thrown).
   void send_response(const RequestId& id, void* response, std::size_t bytes);
+  // Tells the client that asked that this request will not be answered (its
+  // future throws ServiceUnavailable); a client that is gone is counted in
+  // failures(), never thrown.
+  void fail_request(const RequestId& id);
   const std::string& service_name() const;
   std::uint64_t calls() const;     // requests handed to the callback
   std::uint64_t failures() const;  // requests refused and responses not delivered
@@ -58,6 +62,8 @@ class ServiceCore : public SubscriptionBase {
 
  private:
   void deliver(const void* message, EntryReference* reference, const MessageInfo& info) final;
+  // A response or a failure, loaned, to the client that asked.
+  void send_reply(const RequestId& id, void* response, std::size_t bytes, ServiceStatus status);
 
   struct State;
   std::unique_ptr<State> state_;

@@ -60,8 +60,8 @@ class CdrToPool {
     tail_ += bytes;
     return at;
   }
-  void store_pointer(std::byte* at, const void* pointer) {
-    if (!dry_) std::memcpy(at, &pointer, sizeof pointer);
+  static void store_pointer(std::byte* at, const void* pointer) {
+    std::memcpy(at, &pointer, sizeof pointer);
   }
 
   void message(const SchemaType& type, std::byte* at) {
@@ -84,11 +84,14 @@ class CdrToPool {
             fail("sequence '" + field.name + "' longer than the input");
           const std::size_t bytes = static_cast<std::size_t>(n) * field.element_size;
           std::byte* first = reserve(bytes, field.element_align);
-          if (!dry_) std::memset(first, 0, bytes);
-          const NativeContainerWords& words = native_container_words();
-          store_pointer(value + words.layout.vector_begin_offset, first);
-          store_pointer(value + words.layout.vector_end_offset, first + bytes);
-          store_pointer(value + words.vector_capacity_offset, first + bytes);
+          // The measuring pass has no block: no address to compute, even unused.
+          if (!dry_) {
+            std::memset(first, 0, bytes);
+            const NativeContainerWords& words = native_container_words();
+            store_pointer(value + words.layout.vector_begin_offset, first);
+            store_pointer(value + words.layout.vector_end_offset, first + bytes);
+            store_pointer(value + words.vector_capacity_offset, first + bytes);
+          }
           elements(field, first, n);
           break;
         }

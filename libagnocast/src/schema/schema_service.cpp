@@ -8,13 +8,17 @@
 
 namespace agnocast {
 
-class SchemaService::Core : public detail::ServiceCore {
+class SchemaService::Core : public detail::ServiceCore,
+                            public std::enable_shared_from_this<SchemaService::Core> {
  public:
-  Core(Node& node, std::string_view service, const ServiceTypes& types, const QoS& qos,
-       Callback callback, const SubscriptionOptions& options)
+  Core(Node& node, std::string_view service, ServiceTypes types, const QoS& qos, Callback callback,
+       const SubscriptionOptions& options)
       : ServiceCore(node.state(), service, qos, types.request.message_type(),
                     types.response.message_type(), empty_response(types.response.schema), options),
+        types_(std::move(types)),
         callback_(std::move(callback)) {}
+
+  const ServiceTypes& types() const { return types_; }
 
  private:
   // The word a stopping server sends carries no response: its clients read
@@ -32,37 +36,38 @@ class SchemaService::Core : public detail::ServiceCore {
   void handle_request(const void* request, detail::EntryReference* reference,
                       const RequestId& id) override {
     SchemaMessage held(request, detail::pool_holding(request), reference);
-    callback_(std::move(held), id);
+    callback_(std::move(held), Responder(shared_from_this(), id));
   }
 
+  const ServiceTypes types_;
   Callback callback_;
 };
 
+void SchemaService::Responder::send(void* response, std::size_t bytes) const {
+  core_->send_response(id_, response, bytes);
+}
+
+void SchemaService::Responder::send_cdr(std::span<const std::uint8_t> cdr) const {
+  const detail::CdrLoan loan = detail::loan_from_cdr(core_->types().response.schema, cdr);
+  send(loan.message, loan.bytes);
+}
+
 SchemaService::SchemaService(Node& node, std::string_view service, ServiceTypes types,
                              Callback callback, const QoS& qos,
-                             std::shared_ptr<CallbackGroup> group)
-    : types_(std::move(types)) {
-  require_native_layout(types_.response.schema.containers, types_.response.type_name,
+                             std::shared_ptr<CallbackGroup> group) {
+  require_native_layout(types.response.schema.containers, types.response.type_name,
                         "a service response built here");
   SubscriptionOptions options;
   options.callback_group = detail::group_or_default(*node.state(), std::move(group));
-  core_ = std::make_shared<Core>(node, service, types_, qos, std::move(callback), options);
+  core_ =
+      std::make_shared<Core>(node, service, std::move(types), qos, std::move(callback), options);
   detail::register_waitable(*node.state(), core_);
 }
 
 SchemaService::~SchemaService() = default;
 
+const ServiceTypes& SchemaService::types() const { return core_->types(); }
 const std::string& SchemaService::service_name() const { return core_->service_name(); }
-
-void SchemaService::send_response(const RequestId& id, void* response, std::size_t bytes) {
-  core_->send_response(id, response, bytes);
-}
-
-void SchemaService::send_response_cdr(const RequestId& id, std::span<const std::uint8_t> cdr) {
-  const detail::CdrLoan loan = detail::loan_from_cdr(types_.response.schema, cdr);
-  send_response(id, loan.message, loan.bytes);
-}
-
 std::uint64_t SchemaService::calls() const { return core_->calls(); }
 std::uint64_t SchemaService::failures() const { return core_->failures(); }
 

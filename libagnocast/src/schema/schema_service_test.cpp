@@ -57,16 +57,15 @@ TEST_F(SchemaServiceTest, AnswersACompiledClientReadingTheRequestInItsPool) {
   const std::string name = topic("sum");
   const ServiceTypes types = service_types_of<Sum>(name);
   const void* request_seen = nullptr;
-  SchemaService* self = nullptr;
-  SchemaService service(node, name, types, [&](SchemaMessage request, const RequestId& id) {
-    request_seen = request.data();
-    const std::string text =
-        render_message_json(request.data(), types.request.schema, {.readable = request.readable()});
-    EXPECT_EQ(text, R"({"a":40,"b":2})");
-    self->send_response_cdr(
-        id, json_to_cdr(R"({"sum": 42, "note": "from the schema"})", types.response.schema));
-  });
-  self = &service;
+  SchemaService service(
+      node, name, types, [&](SchemaMessage request, SchemaService::Responder responder) {
+        request_seen = request.data();
+        const std::string text = render_message_json(request.data(), types.request.schema,
+                                                     {.readable = request.readable()});
+        EXPECT_EQ(text, R"({"a":40,"b":2})");
+        responder.send_cdr(
+            json_to_cdr(R"({"sum": 42, "note": "from the schema"})", types.response.schema));
+      });
   EXPECT_EQ(service.service_name(), name);
   auto client = node.create_client<Sum>(name);
   ASSERT_TRUE(client->service_is_ready());
@@ -82,22 +81,25 @@ TEST_F(SchemaServiceTest, AnswersACompiledClientReadingTheRequestInItsPool) {
   EXPECT_EQ(service.calls(), 1U);
 }
 
-TEST_F(SchemaServiceTest, AnswersLaterWithALoanOfItsOwn) {
+TEST_F(SchemaServiceTest, AnswersLaterWithALoanOfItsOwnEvenOnceDestroyed) {
   Node node{"later"};
   const std::string name = topic("later");
   const ServiceTypes types = service_types_of<Sum>(name);
-  std::vector<RequestId> kept;
-  SchemaService service(node, name, types,
-                        [&](SchemaMessage, const RequestId& id) { kept.push_back(id); });
+  std::vector<SchemaService::Responder> kept;
+  auto service = std::make_unique<SchemaService>(
+      node, name, types,
+      [&](SchemaMessage, SchemaService::Responder responder) { kept.push_back(responder); });
   auto client = node.create_client<Sum>(name);
   Future first = send(*client, 1, 0);
   Future second = send(*client, 2, 0);
   ASSERT_TRUE(spin_until(node, [&] { return kept.size() == 2; }));
+  EXPECT_NE(kept[0].id(), kept[1].id());
+  service.reset();  // the responders keep the server
   for (int i = 1; i >= 0; --i) {
     auto* response = static_cast<Sum::Response*>(allocate_message(
         sizeof(Sum::Response), alignof(Sum::Response), &destroy_message_object<Sum::Response>));
     new (response) Sum::Response{static_cast<std::int64_t>(10 * (i + 1)), {}};
-    service.send_response(kept[i], response, sizeof(Sum::Response));
+    kept[i].send(response, sizeof(Sum::Response));
   }
   ASSERT_TRUE(spin_until(node, [&] { return ready(first) && ready(second); }));
   EXPECT_EQ(first.get()->sum, 10);
@@ -108,20 +110,19 @@ TEST_F(SchemaServiceTest, ASchemaClientAndASchemaServerTalk) {
   Node node{"schemas"};
   const std::string name = topic("schemas");
   const ServiceTypes types = service_types_of<Sum>(name);
-  SchemaService* self = nullptr;
-  SchemaService service(node, name, types, [&](SchemaMessage request, const RequestId& id) {
-    std::vector<std::uint8_t> cdr;
-    serialize_with_schema(request.data(), types.request.schema, cdr,
-                          {.readable = request.readable()});
-    // {a, b} little-endian after the header: answer a + b.
-    std::int64_t a = 0;
-    std::int64_t b = 0;
-    std::memcpy(&a, cdr.data() + 4, 8);
-    std::memcpy(&b, cdr.data() + 12, 8);
-    self->send_response_cdr(
-        id, json_to_cdr(R"({"sum": )" + std::to_string(a + b) + "}", types.response.schema));
-  });
-  self = &service;
+  SchemaService service(
+      node, name, types, [&](SchemaMessage request, SchemaService::Responder responder) {
+        std::vector<std::uint8_t> cdr;
+        serialize_with_schema(request.data(), types.request.schema, cdr,
+                              {.readable = request.readable()});
+        // {a, b} little-endian after the header: answer a + b.
+        std::int64_t a = 0;
+        std::int64_t b = 0;
+        std::memcpy(&a, cdr.data() + 4, 8);
+        std::memcpy(&b, cdr.data() + 12, 8);
+        responder.send_cdr(
+            json_to_cdr(R"({"sum": )" + std::to_string(a + b) + "}", types.response.schema));
+      });
   SchemaClient client(node, name, types);
   std::optional<std::string> answer;
   client.send_cdr(json_to_cdr(R"({"a": 3, "b": 4})", types.request.schema),
@@ -138,14 +139,14 @@ TEST_F(SchemaServiceTest, ResponseBytesThatAreNoResponseAreRefusedWithNothingSen
   Node node{"bad"};
   const std::string name = topic("bad");
   const ServiceTypes types = service_types_of<Sum>(name);
-  std::vector<RequestId> kept;
-  SchemaService service(node, name, types,
-                        [&](SchemaMessage, const RequestId& id) { kept.push_back(id); });
+  std::vector<SchemaService::Responder> kept;
+  SchemaService service(node, name, types, [&](SchemaMessage, SchemaService::Responder responder) {
+    kept.push_back(responder);
+  });
   auto client = node.create_client<Sum>(name);
   Future future = send(*client, 1, 1);
   ASSERT_TRUE(spin_until(node, [&] { return kept.size() == 1; }));
-  EXPECT_THROW(service.send_response_cdr(kept[0], std::vector<std::uint8_t>{0, 1, 0, 0, 1}),
-               cdr::Error);
+  EXPECT_THROW(kept[0].send_cdr(std::vector<std::uint8_t>{0, 1, 0, 0, 1}), cdr::Error);
   EXPECT_EQ(client->pending(), 1U);
 }
 
@@ -153,12 +154,12 @@ TEST_F(SchemaServiceTest, DestroyedItFailsWhatItLeftUnanswered) {
   Node node{"stops"};
   const std::string name = topic("stops");
   const ServiceTypes types = service_types_of<Sum>(name);
-  std::vector<RequestId> kept;
+  int asked = 0;
   auto service = std::make_unique<SchemaService>(
-      node, name, types, [&](SchemaMessage, const RequestId& id) { kept.push_back(id); });
+      node, name, types, [&](SchemaMessage, SchemaService::Responder) { ++asked; });
   auto client = node.create_client<Sum>(name);
   Future future = send(*client, 1, 1);
-  ASSERT_TRUE(spin_until(node, [&] { return kept.size() == 1; }));
+  ASSERT_TRUE(spin_until(node, [&] { return asked == 1; }));
   service.reset();
   ASSERT_TRUE(spin_until(node, [&] { return ready(future); }));
   EXPECT_THROW(future.get(), ServiceUnavailable);
@@ -170,7 +171,8 @@ TEST_F(SchemaServiceTest, ASecondServerOfANameIsRefused) {
   auto first = node.create_service<Sum>(
       name, [](const ipc_shared_ptr<const Sum::Request>&, ipc_shared_ptr<Sum::Response>&) {});
   try {
-    SchemaService second(node, name, service_types_of<Sum>(name), [](SchemaMessage, auto&) {});
+    SchemaService second(node, name, service_types_of<Sum>(name),
+                         [](SchemaMessage, SchemaService::Responder) {});
     FAIL() << "a second server was accepted";
   } catch (const ServiceExists& error) {
     EXPECT_NE(std::string(error.what()).find("pid " + std::to_string(::getpid())),

@@ -8,7 +8,11 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
+#include "agnocast/message_traits.hpp"
+#include "agnocast/naming.hpp"
+#include "agnocast/schema.hpp"
 #include "agnocast/schema_topic.hpp"
 
 namespace agnocast {
@@ -37,5 +41,25 @@ std::optional<ServiceTypes> find_service_types(std::string_view service);
 // the parts of the service type `type` ("pkg/srv/Name" or "pkg/Name").
 void require_service_type(const ServiceTypes& types, std::string_view service,
                           std::string_view type);
+
+// What a topic carrying messages of compiled type T registers.
+template <Publishable T>
+SchemaTopic schema_topic_of(std::string topic) {
+  SchemaTopic part;
+  part.topic = std::move(topic);
+  part.type_name = std::string(message_traits<T>::type_name);
+  part.type_hash = message_traits<T>::type_hash;
+  const auto blob = schema_of<T>();
+  part.blob.assign(blob.begin(), blob.end());
+  part.schema = parse_schema(part.blob);
+  return part;
+}
+
+// The types of a service of compiled type Srv (a tool's own, or a test's).
+template <class Srv>
+ServiceTypes service_types_of(std::string_view service) {
+  return {schema_topic_of<typename Srv::Request>(service_request_topic(service)),
+          schema_topic_of<typename Srv::Response>(service_reply_topic(service))};
+}
 
 }  // namespace agnocast

@@ -1,15 +1,11 @@
 // A service type for the tests of SchemaClient and SchemaService, declared
-// as agnocast-msggen would generate it, and its parts as ServiceTypes.
+// as agnocast-msggen would generate it.
 #pragma once
 
 #include <cstdint>
-#include <string>
 #include <string_view>
-#include <vector>
 
 #include "agnocast/allocator.hpp"
-#include "agnocast/naming.hpp"
-#include "agnocast/schema_service_types.hpp"
 #include "agnocast/service_traits.hpp"
 
 namespace schema_service_test {
@@ -63,26 +59,3 @@ struct agnocast::service_traits<schema_service_test::Wide> {
   static constexpr std::uint64_t response_type_hash =
       message_traits<schema_service_test::WideResponse>::type_hash;
 };
-
-namespace agnocast {
-
-// What the kernel would report for a service of compiled type Srv.
-template <class T>
-SchemaTopic schema_topic_of(std::string topic) {
-  SchemaTopic part;
-  part.topic = std::move(topic);
-  part.type_name = std::string(message_traits<T>::type_name);
-  part.type_hash = message_traits<T>::type_hash;
-  const auto blob = schema_of<T>();
-  part.blob.assign(blob.begin(), blob.end());
-  part.schema = parse_schema(part.blob);
-  return part;
-}
-
-template <class Srv>
-ServiceTypes service_types_of(std::string_view service) {
-  return {schema_topic_of<typename Srv::Request>(service_request_topic(service)),
-          schema_topic_of<typename Srv::Response>(service_reply_topic(service))};
-}
-
-}  // namespace agnocast

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -38,5 +39,10 @@ struct JsonToCdrOptions {
 // string holding a NUL. Also for a type CDR cannot write (opaque bytes).
 std::vector<std::uint8_t> json_to_cdr(std::string_view json, const Schema& schema,
                                       const JsonToCdrOptions& options = {});
+
+// Empty when `json` is JSON nested no deeper than a message can be, else
+// what json_to_cdr() would throw for it: for checking the text before the
+// type is known.
+std::string json_syntax_problem(std::string_view json);
 
 }  // namespace agnocast

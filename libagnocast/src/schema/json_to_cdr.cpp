@@ -296,4 +296,13 @@ std::vector<std::uint8_t> json_to_cdr(std::string_view text, const Schema& schem
   return out;
 }
 
+std::string json_syntax_problem(std::string_view json) {
+  try {
+    parse(json);
+  } catch (const JsonInputError& error) {
+    return error.what();
+  }
+  return {};
+}
+
 }  // namespace agnocast

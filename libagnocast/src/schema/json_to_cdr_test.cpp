@@ -273,6 +273,14 @@ TEST_F(JsonToCdr, TextThatIsNoJsonIsRefused) {
   }
 }
 
+TEST_F(JsonToCdr, SyntaxIsCheckedWithoutTheType) {
+  EXPECT_EQ(json_syntax_problem(R"({"anything": [1, {"at": "all"}]})"), "");
+  EXPECT_EQ(json_syntax_problem("[]"), "");
+  EXPECT_EQ(json_syntax_problem("{").rfind("not JSON: ", 0), 0U);
+  EXPECT_EQ(json_syntax_problem(std::string(1000, '[')),
+            "the JSON nests deeper than any message (66 levels)");
+}
+
 TEST_F(JsonToCdr, DeepNestingIsRefusedWhileParsing) {
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');
   EXPECT_EQ(refusal(deep), "the JSON nests deeper than any message (66 levels)");

@@ -41,7 +41,19 @@ _agnocast_cli() {
       fi
       ;;
     "topic ") candidates="list info hz echo" ;;
-    "service ") candidates="list info type" ;;
+    "service ") candidates="list info type call" ;;
+    "service call")
+      # NAME, then its TYPE as the service says it; the JSON is the user's.
+      if [[ $cur == -* ]]; then
+        candidates="--timeout --json --help"
+      elif [[ ${#words[@]} -eq 2 ]]; then
+        candidates=$(_agnocast_cli_names service)
+      elif [[ ${#words[@]} -eq 3 ]]; then
+        candidates=$(agnocast-cli service type "${words[2]}" 2>/dev/null)
+      else
+        return
+      fi
+      ;;
     "queue ") candidates="list" ;;
     "node ") candidates="list info" ;;
     "process ") candidates="list" ;;

@@ -6,6 +6,7 @@
 
 #include "agnocast/naming.hpp"
 #include "commands.hpp"
+#include "service_call.hpp"
 #include "table.hpp"
 
 namespace agnocast::cli {
@@ -263,6 +264,8 @@ void set_service_command(CLI::App& app, Context& context) {
   bind_command(
       *type, context,
       {[&context, name] { return service_type_json(context.source, *name); }, service_type_table});
+
+  set_service_call_command(*service, context);
 }
 
 }  // namespace agnocast::cli

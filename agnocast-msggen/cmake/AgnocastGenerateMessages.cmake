@@ -9,9 +9,9 @@
 # A dependency is a target made by this function, or a package of the standard
 # set (std_msgs, geometry_msgs, sensor_msgs, nav_msgs, ...: agnocast::<name>).
 # PYTHON also makes <target>_python, which writes the Python message module
-# <dir>/agnocast/msg/<package>.py (see AgnocastPythonMessages.cmake); <dir> is
+# <dir>/agnocast/msg/<package>.py and, for .srv files, the service module
+# <dir>/agnocast/srv/<package>.py (see AgnocastPythonMessages.cmake); <dir> is
 # the target's property AGNOCAST_PYTHON_DIR, for PYTHONPATH or installation.
-# Services have no Python module yet: PYTHON writes the messages only.
 
 include(${CMAKE_CURRENT_LIST_DIR}/AgnocastPythonMessages.cmake)
 

@@ -2,9 +2,11 @@
 // faults a request's path can meet, each with a bound on how long anyone waits.
 #include <malloc.h>
 
+#include <agnocast/access_policy.hpp>
 #include <agnocast/inspect.hpp>
 #include <agnocast/naming.hpp>
 #include <agnocast/service.hpp>
+#include <agnocast/service_access.hpp>
 #include <example_interfaces/srv/add_two_ints.hpp>
 #include <std_srvs/srv/set_bool.hpp>
 #include <atomic>
@@ -313,6 +315,45 @@ TEST(Services, ARequestNamingAnotherProcesssClientIsIgnored) {
   for (const auto& subscriber : replies->subscribers) {
     EXPECT_EQ(subscriber.received + subscriber.unreceived, 0U) << "subscriber " << subscriber.id;
   }
+}
+
+// The access policy says who may serve and who may call: here root serves and
+// nobody (in group agnocast) may call but not serve.
+TEST(Services, ThePolicyDecidesWhoMayServeAndWhoMayCall) {
+  const std::string name = unique_service("guarded");
+  agnocast::ServiceAccessRule rule;
+  rule.services = name;
+  rule.serve = std::vector{agnocast::AccessPrincipal{agnocast::AccessPrincipal::Kind::user, 0}};
+  rule.call = std::vector{agnocast::AccessPrincipal{}};  // anyone
+  agnocast::AccessPolicy policy;
+  for (auto& topic_rule : agnocast::topic_rules_of(rule)) policy.rules.push_back(topic_rule);
+  agnocast::set_access_policy(policy);
+  Pipe serving, stop;
+  const pid_t server = serve_in_child(name, serving, stop);
+  const bool served = serving.receive(30s) == 'x';
+  const int status = wait_child(fork_child([&] {
+    if (!agnocast_test::become(65534, 65534, {agnocast_test::vm_agnocast_gid})) return 100;
+    agnocast::Node node{"outsider"};
+    try {
+      auto rogue = node.create_service<AddTwoInts>(unique_service("guarded_other"), adder());
+      auto usurper = node.create_service<AddTwoInts>(name, adder());
+      return 2;  // served although only root may
+    } catch (const agnocast::AccessDenied& error) {
+      if (std::string(error.what()).find(name) == std::string::npos) return 3;
+    }
+    auto client = node.create_client<AddTwoInts>(name);
+    if (!client->wait_for_service(10s)) return 4;
+    agnocast::SingleThreadedExecutor executor;
+    executor.add_node(node);
+    Future future = send(*client, 20, 22);
+    if (!spin_until(executor, [&] { return ready(future); }, 10s)) return 5;
+    return future.get()->sum == 42 ? 0 : 6;
+  }));
+  stop.send();
+  wait_child(server);
+  agnocast::set_access_policy(std::nullopt);
+  ASSERT_TRUE(served);
+  EXPECT_TRUE(exited_ok(status)) << "the step that failed: " << WEXITSTATUS(status);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -26,7 +27,9 @@
 #include "agnocast/errors.hpp"
 #include "agnocast/log.hpp"
 #include "agnocast/schema.hpp"
+#include "agnocast/schema_client.hpp"
 #include "agnocast/schema_definition.hpp"
+#include "agnocast/schema_service.hpp"
 #include "agnocast/schema_subscriber.hpp"
 #include "erased_message.hpp"
 #include "log_forwarder.hpp"
@@ -142,6 +145,8 @@ struct Storage {
   bool loan = false;
   bool published = false;
   detail::EntryReference* reference = nullptr;
+  // A service's request or response, held instead of a reference.
+  std::optional<SchemaMessage> held;
   // What a read may touch: everything for a loan, the publisher's pool for a
   // received message, whose every pointer is the publisher's to write.
   ForeignMemory memory;
@@ -618,6 +623,17 @@ Message received(const MessageClass* cls, const void* message, detail::EntryRefe
   return Message{storage, static_cast<std::byte*>(storage->message), 0};
 }
 
+// A service's request or response, read in place where its sender wrote it.
+Message received(const MessageClass* cls, SchemaMessage&& message) {
+  auto storage = std::make_shared<Storage>();
+  storage->cls = cls;
+  storage->message = const_cast<void*>(message.data());
+  storage->memory = ForeignMemory(message.readable());
+  storage->problem = message_problem(cls->type(), message.data(), storage->memory);
+  storage->held.emplace(std::move(message));
+  return Message{storage, static_cast<std::byte*>(storage->message), 0};
+}
+
 detail::MessageType type_of(const MessageClass* cls) {
   return detail::MessageType{cls->type().name, cls->type().hash, cls->schema.blob()};
 }
@@ -648,6 +664,24 @@ Message new_loan(const MessageClass* cls) {
   return Message{storage, static_cast<std::byte*>(memory), 0};
 }
 
+// The loan of a message of its own (borrowed, or made by calling its class),
+// handed over to be sent: the message object is spent from here on.
+void* hand_over(const Message& message, const MessageClass* cls, const char* what) {
+  Storage& storage = *message.storage;
+  if (!storage.loan || message.base != storage.message) {
+    throw py::value_error(std::string("agnocast: ") + what +
+                          " needs a message from borrow_loaned_message(), not a received or "
+                          "nested one");
+  }
+  storage.check();
+  if (storage.cls->type().hash != cls->type().hash) {
+    throw py::type_error(std::string("agnocast: ") + what + " takes a " + cls->type().name +
+                         ", not a " + storage.cls->type().name);
+  }
+  storage.published = true;
+  return storage.message;
+}
+
 class PyPublisher {
  public:
   PyPublisher(const Node& node, const MessageClass* cls, const std::string& topic, const QoS& qos)
@@ -656,19 +690,7 @@ class PyPublisher {
   py::object borrow() { return to_python(new_loan(cls_)); }
 
   void publish(const Message& message) {
-    Storage& storage = *message.storage;
-    if (!storage.loan || message.base != storage.message) {
-      throw py::value_error(
-          "agnocast: publish needs a message from borrow_loaned_message(), not a received or "
-          "nested one");
-    }
-    storage.check();
-    if (storage.cls->type().hash != cls_->type().hash) {
-      throw py::type_error("agnocast: this publisher sends " + cls_->type().name + ", not " +
-                           storage.cls->type().name);
-    }
-    storage.published = true;
-    void* memory = storage.message;
+    void* memory = hand_over(message, cls_, "publish");
     const std::uint64_t bytes = detail::published_bytes(memory, cls_->type().size);
     py::gil_scoped_release release;
     core_.publish(memory, bytes);
@@ -739,6 +761,188 @@ class PyPolling {
  private:
   const MessageClass* cls_;
   detail::PollingCore core_;
+};
+
+// What a topic carrying the class's messages registers.
+SchemaTopic schema_topic(std::string topic, const MessageClass* cls) {
+  SchemaTopic part;
+  part.topic = std::move(topic);
+  part.type_name = cls->type().name;
+  part.type_hash = cls->type().hash;
+  const auto blob = cls->schema.blob();
+  part.blob.assign(blob.begin(), blob.end());
+  part.schema = cls->schema.schema();
+  return part;
+}
+
+ServiceTypes service_types(const std::string& service, const MessageClass* request,
+                           const MessageClass* response) {
+  validate_service_name(service);
+  return {schema_topic(service_request_topic(service), request),
+          schema_topic(service_reply_topic(service), response)};
+}
+
+// The Python exception a failed call's exception is (ServiceUnavailable, ...).
+py::object exception_object(std::exception_ptr error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (...) {
+    raise_current_exception();
+  }
+  PyObject* type = nullptr;
+  PyObject* value = nullptr;
+  PyObject* trace = nullptr;
+  PyErr_Fetch(&type, &value, &trace);
+  PyErr_NormalizeException(&type, &value, &trace);
+  if (trace) PyException_SetTraceback(value, trace);
+  Py_XDECREF(type);
+  Py_XDECREF(trace);
+  return py::reinterpret_steal<py::object>(value);
+}
+
+// agnocast.InvalidMessage (set when the module loads).
+py::object& invalid_message_type() {
+  static auto* type = new py::object;
+  return *type;
+}
+
+std::chrono::nanoseconds timeout_of(const py::object& seconds) {
+  // None waits as good as forever: a century.
+  if (seconds.is_none()) return std::chrono::hours(24 * 365 * 100);
+  const double value = py::cast<double>(seconds);
+  return std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(value, 0.0) * 1e9));
+}
+
+// A server: each request, read in place in the client's pool, and a new
+// response from this process's pool go to the Python callback, which fills
+// the response; it is sent when the callback returns.
+class PyService {
+ public:
+  PyService(Node& node, const MessageClass* request, const MessageClass* response,
+            const std::string& service, const QoS& qos, Callback callback,
+            std::shared_ptr<CallbackGroup> group)
+      : service_(node, service, service_types(service, request, response),
+                 [service, request, response, callback = std::move(callback)](
+                     SchemaMessage message, SchemaService::Responder responder) {
+                   answer(service, request, response, callback, std::move(message), responder);
+                 },
+                 qos, std::move(group)) {}
+
+  const std::string& name() const { return service_.service_name(); }
+
+ private:
+  // Runs on the executor's thread; captures nothing of the PyService, which
+  // Python may destroy while a request waits for the GIL.
+  static void answer(const std::string& service, const MessageClass* request_class,
+                     const MessageClass* response_class, const Callback& callback,
+                     SchemaMessage request, const SchemaService::Responder& responder) {
+    py::gil_scoped_acquire gil;
+    const py::object request_object = to_python(received(request_class, std::move(request)));
+    const Message response = new_loan(response_class);
+    const py::object response_object = to_python(response);
+    py::object returned;
+    try {
+      returned = (*callback)(request_object, response_object);
+    } catch (py::error_already_set& error) {
+      // A request whose containers lie is the client's fault: refused, and
+      // the server carries on. Any other exception stops spin(), as a
+      // subscription's does.
+      if (!error.matches(invalid_message_type())) throw;
+      py::module_::import("logging")
+          .attr("getLogger")("agnocast")
+          .attr("warning")("agnocast: service " + service +
+                           ": a request of client " + std::to_string(responder.id().client) +
+                           " was refused unanswered: " + py::str(error.value()).cast<std::string>());
+      return;
+    }
+    // The callback may also return the response, as rclpy's do.
+    Message sent = response;
+    if (!returned.is_none() && !returned.is(response_object)) sent = py::cast<Message>(returned);
+    void* memory = hand_over(sent, response_class, "a service's response");
+    const std::uint64_t bytes = detail::published_bytes(memory, response_class->type().size);
+    py::gil_scoped_release release;
+    responder.send(memory, bytes);
+  }
+
+  SchemaService service_;
+};
+
+// A client: requests are messages of their own in this process's pool, each
+// response is read in place in the server's pool.
+class PyClient {
+ public:
+  PyClient(Node& node, const MessageClass* request, const MessageClass* response,
+           const std::string& service, const QoS& qos, std::shared_ptr<CallbackGroup> group)
+      : request_(request),
+        response_(response),
+        client_(node, service, service_types(service, request, response), qos, std::move(group)) {}
+
+  py::object borrow() { return to_python(new_loan(request_)); }
+
+  // Waits for the answer without the GIL; TimeoutError when none came.
+  py::object call(const Message& request, const py::object& timeout_sec) {
+    const std::chrono::nanoseconds timeout = timeout_of(timeout_sec);
+    void* memory = hand_over(request, request_, "call");
+    const std::uint64_t bytes = detail::published_bytes(memory, request_->type().size);
+    std::optional<SchemaMessage> response = [&] {
+      py::gil_scoped_release release;
+      return client_.call(memory, bytes, timeout);
+    }();
+    if (!response) {
+      PyErr_SetString(PyExc_TimeoutError,
+                      ("agnocast: service " + client_.service_name() + " did not answer within " +
+                       py::str(timeout_sec).cast<std::string>() + " s")
+                          .c_str());
+      throw py::error_already_set();
+    }
+    return to_python(received(response_, std::move(*response)));
+  }
+
+  // done(response, None) or done(None, exception), once, from the executor
+  // spinning the node (or at once, when the request failed at the start).
+  py::tuple send(const Message& request, py::object done) {
+    void* memory = hand_over(request, request_, "call_async");
+    const std::uint64_t bytes = detail::published_bytes(memory, request_->type().size);
+    Callback held(std::move(done));
+    const MessageClass* response_class = response_;
+    RequestId id;
+    {
+      py::gil_scoped_release release;
+      id = client_.send(memory, bytes,
+                        [held, response_class](std::optional<SchemaMessage> response,
+                                               std::exception_ptr error) {
+                          py::gil_scoped_acquire gil;
+                          if (error) {
+                            (*held)(py::none(), exception_object(error));
+                            return;
+                          }
+                          (*held)(to_python(received(response_class, std::move(*response))),
+                                  py::none());
+                        });
+    }
+    return py::make_tuple(id.client, id.sequence);
+  }
+
+  bool forget(std::uint32_t client, std::uint64_t sequence) {
+    return client_.forget(RequestId{client, sequence});
+  }
+  std::size_t prune() { return client_.prune_pending(); }
+  std::size_t pending() const { return client_.pending(); }
+  bool ready() const {
+    py::gil_scoped_release release;
+    return client_.service_is_ready();
+  }
+  bool wait(const py::object& timeout_sec) const {
+    const std::chrono::nanoseconds timeout = timeout_of(timeout_sec);
+    py::gil_scoped_release release;
+    return client_.wait_for_service(timeout);
+  }
+  const std::string& name() const { return client_.service_name(); }
+
+ private:
+  const MessageClass* request_;
+  const MessageClass* response_;
+  SchemaClient client_;
 };
 
 // The Python log handler (agnocast/__init__.py passes logging's), touched
@@ -813,6 +1017,12 @@ PYBIND11_MODULE(_core, m) {
   static py::exception<PoolExhausted> pool_exhausted(m, "PoolExhausted", error.ptr());
   static py::exception<MessagePublished> message_published(m, "MessagePublished", error.ptr());
   static py::exception<ReadOnlyMessage> read_only(m, "ReadOnlyMessage", error.ptr());
+  static py::exception<ServiceExists> service_exists(m, "ServiceExists", error.ptr());
+  static py::exception<ServiceUnavailable> service_unavailable(m, "ServiceUnavailable",
+                                                               error.ptr());
+  static py::exception<RequestRejected> request_rejected(m, "RequestRejected", error.ptr());
+  static py::exception<TooManyRequests> too_many_requests(m, "TooManyRequests", error.ptr());
+  invalid_message_type() = invalid_message;
   // Tried last registered first: derived classes before their bases.
   py::register_exception_translator([](std::exception_ptr failure) {
     try {
@@ -837,6 +1047,14 @@ PYBIND11_MODULE(_core, m) {
       read_only(e.what());
     } catch (const InvalidMessage& e) {
       invalid_message(e.what());
+    } catch (const ServiceExists& e) {
+      service_exists(e.what());
+    } catch (const ServiceUnavailable& e) {
+      service_unavailable(e.what());
+    } catch (const RequestRejected& e) {
+      request_rejected(e.what());
+    } catch (const TooManyRequests& e) {
+      too_many_requests(e.what());
     } catch (const Error& e) {
       error(e.what());
     } catch (const SchemaError& e) {
@@ -1087,6 +1305,39 @@ PYBIND11_MODULE(_core, m) {
       .def("get_publisher_count", &PyPolling::publisher_count)
       .def_property_readonly("topic_name", &PyPolling::topic);
 
+  py::class_<PyService, std::shared_ptr<PyService>>(m, "Service")
+      .def(py::init([](Node& node, const MessageClass& request, const MessageClass& response,
+                       const std::string& name, const QoS& qos, py::object callback,
+                       std::shared_ptr<CallbackGroup> group) {
+             Callback held(std::move(callback));
+             py::gil_scoped_release release;
+             return std::make_shared<PyService>(node, &request, &response, name, qos, held,
+                                                std::move(group));
+           }),
+           py::arg("node"), py::arg("request_type"), py::arg("response_type"), py::arg("name"),
+           py::arg("qos"), py::arg("callback"), py::arg("callback_group") = nullptr)
+      .def_property_readonly("service_name", &PyService::name);
+
+  py::class_<PyClient, std::shared_ptr<PyClient>>(m, "Client")
+      .def(py::init([](Node& node, const MessageClass& request, const MessageClass& response,
+                       const std::string& name, const QoS& qos,
+                       std::shared_ptr<CallbackGroup> group) {
+             py::gil_scoped_release release;
+             return std::make_shared<PyClient>(node, &request, &response, name, qos,
+                                               std::move(group));
+           }),
+           py::arg("node"), py::arg("request_type"), py::arg("response_type"), py::arg("name"),
+           py::arg("qos"), py::arg("callback_group") = nullptr)
+      .def("borrow_loaned_request", &PyClient::borrow)
+      .def("_call", &PyClient::call, py::arg("request"), py::arg("timeout_sec"))
+      .def("_send", &PyClient::send, py::arg("request"), py::arg("done"))
+      .def("_forget", &PyClient::forget, py::arg("client"), py::arg("sequence"))
+      .def("_pending", &PyClient::pending)
+      .def("prune_pending_requests", &PyClient::prune)
+      .def("service_is_ready", &PyClient::ready)
+      .def("wait_for_service", &PyClient::wait, py::arg("timeout_sec") = py::none())
+      .def_property_readonly("service_name", &PyClient::name);
+
   py::class_<Timer, std::shared_ptr<Timer>>(m, "Timer")
       .def(py::init([](Node& node, double period, py::object callback,
                        std::shared_ptr<CallbackGroup> group) {
@@ -1159,6 +1410,8 @@ PYBIND11_MODULE(_core, m) {
     set_log_handler(
         [](LogLevel level, std::string_view text) { log_forwarder().post(level, text); });
   });
+  m.attr("SERVICE_QUEUE_DEPTH_DEFAULT") = service_queue_depth_default;
+  m.attr("CLIENT_IN_FLIGHT_DEFAULT") = client_in_flight_default;
   m.attr("LOG_DEBUG") = static_cast<int>(LogLevel::debug);
   m.attr("LOG_INFO") = static_cast<int>(LogLevel::info);
   m.attr("LOG_WARNING") = static_cast<int>(LogLevel::warning);

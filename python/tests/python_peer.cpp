@@ -1,27 +1,40 @@
 // The C++ side of the Python interop tests: publishes or subscribes one typed
-// topic and prints what it sent or received, one line per message, so the
-// Python test can compare (contents, and the pool address of an array).
+// topic, serves or calls one service, and prints what it sent or received,
+// one line per message, so the Python test can compare (contents, and the
+// pool address of an array or a message).
 //
 // usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]
 //        python_peer hostile cloud TOPIC
+//        python_peer serve add SERVICE
+//        python_peer call add SERVICE A B
+//        python_peer hostile-client rate SERVICE
 //   pub: waits for a subscriber, then publishes COUNT messages 100 ms apart
 //        (cloud: SIZE bytes of data, byte i = (i + seq) % 251), then waits
 //        for the end of stdin
 //   sub: prints each message until COUNT arrived, exits 0 (1 after 60 s)
 //   hostile: publishes one cloud per way its containers can lie (see
 //        hostile_clouds), printing the fault's name, then waits for stdin
+//   serve: an example_interfaces/srv/AddTwoInts server; prints "ready", then
+//        per request "add A B REQUEST_ADDRESS RESPONSE_ADDRESS", until stdin ends
+//   call: an AddTwoInts client; prints "sum S RESPONSE_ADDRESS" (exit 1 when
+//        no answer came within 30 s)
+//   hostile-client: a wheel_msgs/srv/Rate client whose first requests lie
+//        (see hostile_rates); prints the answer to the last, honest one
 #include <agnocast/agnocast.hpp>
 #include <agnocast/schema_layout.hpp>
 #include <chrono>
+#include <future>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <example_interfaces/srv/add_two_ints.hpp>
 #include <geometry_msgs/msg/vector3.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
 #include <std_msgs/msg/string.hpp>
 #include <string>
 #include <thread>
 #include <wheel_msgs/msg/wheel.hpp>
+#include <wheel_msgs/srv/rate.hpp>
 
 namespace {
 
@@ -171,16 +184,112 @@ int hostile_clouds(const std::string& topic) {
   std::_Exit(0);
 }
 
+using AddTwoInts = example_interfaces::srv::AddTwoInts;
+using Rate = wheel_msgs::srv::Rate;
+
+int serve_add(const std::string& service) {
+  agnocast::Node node{"python_peer_server"};
+  auto server = node.create_service<AddTwoInts>(
+      service, [](const agnocast::ipc_shared_ptr<const AddTwoInts::Request>& request,
+                  agnocast::ipc_shared_ptr<AddTwoInts::Response>& response) {
+        response->sum = request->a + request->b;
+        std::printf("add %lld %lld %p %p\n", static_cast<long long>(request->a),
+                    static_cast<long long>(request->b), static_cast<const void*>(request.get()),
+                    static_cast<const void*>(response.get()));
+        std::fflush(stdout);
+      });
+  agnocast::SingleThreadedExecutor exec;
+  exec.add_node(node);
+  std::thread spinner([&] { exec.spin(); });
+  std::printf("ready\n");
+  std::fflush(stdout);
+  while (std::getchar() != EOF) {
+  }
+  exec.cancel();
+  spinner.join();
+  return 0;
+}
+
+int call_add(const std::string& service, std::int64_t a, std::int64_t b) {
+  agnocast::Node node{"python_peer_client"};
+  auto client = node.create_client<AddTwoInts>(service);
+  if (!client->wait_for_service(30s)) return 1;
+  auto request = client->borrow_loaned_request();
+  request->a = a;
+  request->b = b;
+  auto future = client->async_send_request(std::move(request));
+  agnocast::SingleThreadedExecutor exec;
+  exec.add_node(node);
+  for (int i = 0; i < 300 && future.wait_for(0s) != std::future_status::ready; ++i) {
+    exec.spin_once(100ms);
+  }
+  if (future.wait_for(0s) != std::future_status::ready) return 1;
+  const auto& response = future.get();
+  std::printf("sum %lld %p\n", static_cast<long long>(response->sum),
+              static_cast<const void*>(response.get()));
+  return 0;
+}
+
+// Requests whose containers lie, one way each, then an honest one, all
+// borrowed before any is sent: a lying request is never destroyed (its
+// destructor would free what its words now point to), as no borrow comes
+// after it to free what was reclaimed, and the process ends with _Exit.
+int hostile_rates(const std::string& service) {
+  const agnocast::ContainerLayout& layout = agnocast::native_container_layout();
+  constexpr std::uintptr_t unmapped = 0x10000;  // below any pool, mapped by no one
+  agnocast::Node node{"python_peer_hostile_client"};
+  auto client = node.create_client<Rate>(service);
+  if (!client->wait_for_service(30s)) return 1;
+  auto speeds_outside = client->borrow_loaned_request();
+  auto name_outside = client->borrow_loaned_request();
+  auto honest = client->borrow_loaned_request();
+  for (auto* request : {speeds_outside.get(), name_outside.get(), honest.get()}) {
+    request->name = "front left, named beyond any small-string buffer";
+    request->speeds = {1.0, 2.0, 4.5};
+  }
+  write_word(&speeds_outside->speeds, layout.vector_begin_offset, unmapped);
+  write_word(&speeds_outside->speeds, layout.vector_end_offset, unmapped + 24);
+  write_word(&name_outside->name, layout.string_data_offset, unmapped);
+  client->async_send_request(std::move(speeds_outside));
+  client->async_send_request(std::move(name_outside));
+  auto future = client->async_send_request(std::move(honest));
+  agnocast::SingleThreadedExecutor exec;
+  exec.add_node(node);
+  for (int i = 0; i < 300 && future.wait_for(0s) != std::future_status::ready; ++i) {
+    exec.spin_once(100ms);
+  }
+  if (future.wait_for(0s) != std::future_status::ready) std::_Exit(1);
+  std::printf("answered %g %s\n", future.get()->mean, future.get()->verdict.c_str());
+  std::fflush(stdout);
+  std::_Exit(0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "hostile" && std::string(argv[2]) == "cloud") {
     return hostile_clouds(argv[3]);
   }
+  try {
+    const std::string mode = argc > 1 ? argv[1] : "";
+    if (argc == 4 && mode == "serve" && std::string(argv[2]) == "add") return serve_add(argv[3]);
+    if (argc == 6 && mode == "call" && std::string(argv[2]) == "add") {
+      return call_add(argv[3], std::atoll(argv[4]), std::atoll(argv[5]));
+    }
+    if (argc == 4 && mode == "hostile-client" && std::string(argv[2]) == "rate") {
+      return hostile_rates(argv[3]);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "python_peer: %s\n", e.what());
+    return 1;
+  }
   if (argc < 5) {
     std::fprintf(stderr,
                  "usage: python_peer pub|sub string|cloud|wheel TOPIC COUNT [SIZE]\n"
-                 "       python_peer hostile cloud TOPIC\n");
+                 "       python_peer hostile cloud TOPIC\n"
+                 "       python_peer serve add SERVICE\n"
+                 "       python_peer call add SERVICE A B\n"
+                 "       python_peer hostile-client rate SERVICE\n");
     return 2;
   }
   const bool publish = std::string(argv[1]) == "pub";

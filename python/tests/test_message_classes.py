@@ -1,4 +1,4 @@
-"""The message classes as Python sees them, without the kernel module (run natively).
+"""The message and service classes as Python sees them, without the kernel module (run natively).
 
 What needs messages in a pool (isinstance of received and loaned messages) is
 in test_agnocast.py, in the VM."""
@@ -9,6 +9,9 @@ from agnocast.msg.geometry_msgs import Vector3
 from agnocast.msg.sensor_msgs import NavSatStatus, PointCloud2, PointField
 from agnocast.msg.std_msgs import Header, String
 from agnocast.msg.wheel_msgs import Wheel
+from agnocast.srv.example_interfaces import AddTwoInts
+from agnocast.srv.std_srvs import Empty, SetBool, Trigger
+from agnocast.srv.wheel_msgs import Rate
 
 
 def test_constants_are_the_msg_files():
@@ -92,3 +95,34 @@ def test_callback_groups_have_the_names_ros_2_users_know():
     assert node.default_callback_group.type == agnocast.CallbackGroupType.MutuallyExclusive
     assert node.create_callback_group(agnocast.CallbackGroupType.Reentrant).type == \
         agnocast.CallbackGroupType.Reentrant
+
+
+def test_service_types_are_classes_holding_their_two_message_classes():
+    for srv, name in [(Empty, "std_srvs/srv/Empty"), (Trigger, "std_srvs/srv/Trigger"),
+                      (SetBool, "std_srvs/srv/SetBool"),
+                      (AddTwoInts, "example_interfaces/srv/AddTwoInts"),
+                      (Rate, "wheel_msgs/srv/Rate")]:
+        assert isinstance(srv, type) and issubclass(srv, agnocast.ServiceType)
+        assert srv.type_name == name
+        assert srv.__name__ == name.rsplit("/", 1)[1]
+        assert srv.__module__ == "agnocast.srv." + name.split("/")[0]
+        assert issubclass(srv.Request, agnocast.Message)
+        assert srv.Request.type_name == name + "_Request"
+        assert srv.Response.type_name == name + "_Response"
+        assert srv.Request.__name__ == srv.__name__ + "_Request"
+    assert SetBool.Request.fields == ["data"]
+    assert SetBool.Response.fields == ["success", "message"]
+    assert Empty.Request.fields == ["structure_needs_at_least_one_member"]
+    assert AddTwoInts.Request.fields == ["a", "b"] and AddTwoInts.Response.fields == ["sum"]
+    assert Rate.Request.definition.startswith("# Rates a wheel from the speeds it reported.\n")
+    assert repr(SetBool) == "<agnocast service class std_srvs/srv/SetBool>"
+
+
+def test_a_service_type_makes_no_instance_and_only_it_makes_a_client():
+    with pytest.raises(TypeError, match="is a service type"):
+        SetBool()
+    node = agnocast.Node("py_not_a_service")
+    with pytest.raises(TypeError, match="not a service type"):
+        node.create_client(SetBool.Request, "/py/not_a_service")
+    with pytest.raises(TypeError, match="not a service type"):
+        node.create_service(String, "/py/not_a_service", print)

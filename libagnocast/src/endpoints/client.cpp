@@ -235,6 +235,17 @@ std::size_t ClientCore::prune_pending() {
   return pruned.size();
 }
 
+bool ClientCore::forget(const RequestId& id) {
+  std::optional<State::Pending> forgotten;  // its completion dies outside the lock
+  std::lock_guard lock(state_->mutex);
+  if (id.client != state_->reply_subscriber) return false;
+  const auto it = state_->pending.find(id.sequence);
+  if (it == state_->pending.end()) return false;
+  forgotten = std::move(it->second);
+  state_->pending.erase(it);
+  return true;
+}
+
 bool ClientCore::service_is_ready() const { return state_->server().has_value(); }
 
 bool ClientCore::wait_for_service(std::chrono::nanoseconds timeout) const {

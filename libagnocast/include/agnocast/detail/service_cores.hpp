@@ -32,7 +32,7 @@ namespace agnocast::detail {
 
 // A default-constructed response loan (allocate_message), for the word a
 // stopping server sends every client.
-using ResponseFactory = void* (*)();
+using ResponseFactory = std::function<void*()>;
 
 class ServiceCore : public SubscriptionBase {
  public:
@@ -90,6 +90,9 @@ class ClientCore : public SubscriptionBase {
   bool wait_for_service(std::chrono::nanoseconds timeout) const;
   // Forgets every pending request (their completions never run); returns how many.
   std::size_t prune_pending();
+  // Forgets one pending request (its completion never runs); false when it
+  // is not pending (answered, failed or forgotten already).
+  bool forget(const RequestId& id);
   std::size_t pending() const;
   const std::string& service_name() const;
 

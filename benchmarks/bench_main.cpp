@@ -912,16 +912,18 @@ int main(int argc, char** argv) {
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
   try {
     json report = run(plan, iceoryx_role, breakdown_program, cli, python);
+    // A smoke run's findings come before the report, where a log's reader
+    // sees them first.
+    std::vector<std::string> errors;
+    if (smoke) errors = bench::report_shape_errors(report);
+    for (const auto& error : errors) std::cerr << "agnocast-bench: report: " << error << "\n";
+    std::cerr.flush();
     if (json_output) {
       std::cout << report.dump() << "\n";
     } else {
       bench::print_markdown(report);
     }
-    if (smoke) {
-      const std::vector<std::string> errors = bench::report_shape_errors(report);
-      for (const auto& error : errors) std::cerr << "agnocast-bench: report: " << error << "\n";
-      if (!errors.empty()) return 1;
-    }
+    if (!errors.empty()) return 1;
   } catch (const std::exception& error) {
     std::cerr << "agnocast-bench: " << error.what() << "\n";
     return 1;

@@ -174,7 +174,9 @@ int main(int argc, char** argv) {
   app.add_option("--ack-fd", options.ack_fd)->required();
   app.add_option("--results-fd", options.results_fd);
   CLI11_PARSE(app, argc, argv);
-  iox::log::LogManager::GetLogManager().SetDefaultLogLevel(iox::log::LogLevel::kWarn);
+  // Quietly: the level's own announcement would fill the benchmark's log.
+  iox::log::LogManager::GetLogManager().SetDefaultLogLevel(iox::log::LogLevel::kWarn,
+                                                           iox::log::LogLevelOutput::kHideLogLevel);
   options.size = bench::parse_size(size_text);
   if (role == "pub") return run_publisher(options);
   return run_subscriber(options);

@@ -134,22 +134,17 @@ class Client : public detail::ClientCore {
     Request* loaned = detail::loan_to_send(
         request, "async_send_request needs a request from borrow_loaned_request() not yet sent");
     detail::close_loan_heap_scope(loaned);
-    auto promise = std::make_shared<std::promise<ipc_shared_ptr<const Response>>>();
-    SharedFuture future = promise->get_future().share();
-    send(loaned, detail::published_bytes(loaned, sizeof(Request)),
-         [promise, future, callback = std::move(callback)](
-             const void* response, detail::EntryReference* reference, std::exception_ptr error) {
-           if (error) {
-             promise->set_exception(error);
-           } else {
-             promise->set_value(detail::MessageAccess::received(
-                 static_cast<const Response*>(response), reference));
-           }
-           if (callback) callback(future);
-         });
+    std::unique_ptr<Call> call;
+    try {
+      call = std::make_unique<Call>(std::move(callback));
+    } catch (...) {
+      detail::discard_message(loaned);
+      throw;
+    }
+    SharedFuture future = call->future;
+    send(loaned, detail::published_bytes(loaned, sizeof(Request)), std::move(call));
     return future;
   }
-
   template <class Rep, class Period>
   bool wait_for_service(std::chrono::duration<Rep, Period> timeout) const {
     return ClientCore::wait_for_service(
@@ -159,6 +154,27 @@ class Client : public detail::ClientCore {
   // Forgets every pending request: their futures are abandoned (broken_promise).
   std::size_t prune_pending_requests() { return prune_pending(); }
   const std::string& get_service_name() const { return service_name(); }
+
+ private:
+  // The promise, its future and the callback in one allocation.
+  struct Call final : detail::PendingCall {
+    explicit Call(std::function<void(SharedFuture)> on_ready)
+        : future(promise.get_future().share()), callback(std::move(on_ready)) {}
+    void complete(const void* response, detail::EntryReference* reference,
+                  std::exception_ptr error) override {
+      if (error) {
+        promise.set_exception(std::move(error));
+      } else {
+        promise.set_value(
+            detail::MessageAccess::received(static_cast<const Response*>(response), reference));
+      }
+      if (callback) callback(future);
+    }
+
+    std::promise<ipc_shared_ptr<const Response>> promise;
+    SharedFuture future;
+    std::function<void(SharedFuture)> callback;
+  };
 };
 
 }  // namespace agnocast

@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -79,11 +79,19 @@ struct ClientCore::State : std::enable_shared_from_this<ClientCore::State> {
         group(std::move(group)),
         bound(qos.depth()),
         requests(std::move(node), service_request_topic(service), QoS(1), request_type,
-                 TopicUse::service_carrier) {}
+                 TopicUse::service_carrier),
+        slots(bound) {
+    free_slots.reserve(bound);
+    for (std::size_t slot = bound; slot-- > 0;)
+      free_slots.push_back(static_cast<std::uint32_t>(slot));
+  }
 
-  struct Pending {
-    std::uint32_t server = 0;  // its reply publisher id
-    Completion completion;
+  // A request in flight. Its sequence number names its slot (sequence %
+  // bound), so an answer finds it without a search or an allocation.
+  struct Slot {
+    std::uint64_t sequence = 0;  // 0: free
+    std::uint32_t server = 0;    // the reply publisher id it was sent to
+    std::unique_ptr<PendingCall> call;
   };
 
   // The server to send to, found in the kernel's tables when there is none
@@ -91,6 +99,13 @@ struct ClientCore::State : std::enable_shared_from_this<ClientCore::State> {
   std::optional<Server> server();
   // The server (reply publisher id) is gone: every request pending there fails.
   void server_gone(std::uint32_t reply_publisher, const std::string& why);
+  // Under mutex: a slot for a request to server, its sequence number set.
+  std::uint64_t occupy(std::uint32_t server, std::unique_ptr<PendingCall>& call);
+  // Under mutex: the call of the request sequence names, its slot freed;
+  // null when that request is not pending.
+  std::unique_ptr<PendingCall> vacate(std::uint64_t sequence, std::optional<std::uint32_t> server);
+  // Under mutex: every pending call, or those sent to server, their slots freed.
+  std::vector<std::unique_ptr<PendingCall>> vacate_all(std::optional<std::uint32_t> server);
 
   const std::string name;
   const std::shared_ptr<NodeState> node;
@@ -99,11 +114,13 @@ struct ClientCore::State : std::enable_shared_from_this<ClientCore::State> {
   PublisherCore requests;
   std::uint32_t reply_subscriber = 0;
   mutable std::mutex mutex;
-  std::uint64_t next_sequence = 1;
-  std::map<std::uint64_t, Pending> pending;
+  std::vector<Slot> slots;
+  std::vector<std::uint32_t> free_slots;
+  std::uint64_t issued = 0;  // requests given a slot so far
   std::optional<Server> current;
   std::shared_ptr<ServerWatch> watch;
-  // Servers known gone whose endpoints may linger a moment (reply publisher ids).
+  // Servers known gone whose endpoints may linger a moment (reply publisher
+  // ids); forgotten once their endpoints are seen gone.
   std::set<std::uint32_t> gone;
 };
 
@@ -130,6 +147,11 @@ std::optional<Server> ClientCore::State::server() {
     std::optional<Server> found;
     {
       std::lock_guard lock(mutex);
+      // A server whose endpoints are gone too need not be remembered.
+      std::erase_if(gone, [&](std::uint32_t id) {
+        return std::none_of(replies.publishers.begin(), replies.publishers.end(),
+                            [id](const auto& publisher) { return publisher.id == id; });
+      });
       for (const auto& publisher : replies.publishers) {
         if (gone.contains(publisher.id)) continue;
         if (!found || publisher.id < found->reply_publisher) {
@@ -174,8 +196,37 @@ std::optional<Server> ClientCore::State::server() {
   return found;
 }
 
+std::uint64_t ClientCore::State::occupy(std::uint32_t to, std::unique_ptr<PendingCall>& call) {
+  const std::uint32_t slot = free_slots.back();
+  free_slots.pop_back();
+  // Never 0 (issued counts from 1), and slot again modulo bound.
+  const std::uint64_t sequence = ++issued * bound + slot;
+  slots[slot] = Slot{sequence, to, std::move(call)};
+  return sequence;
+}
+
+std::unique_ptr<PendingCall> ClientCore::State::vacate(std::uint64_t sequence,
+                                                       std::optional<std::uint32_t> from) {
+  Slot& slot = slots[sequence % bound];
+  if (sequence == 0 || slot.sequence != sequence || (from && slot.server != *from)) return nullptr;
+  slot.sequence = 0;
+  free_slots.push_back(static_cast<std::uint32_t>(sequence % bound));
+  return std::move(slot.call);
+}
+
+std::vector<std::unique_ptr<PendingCall>> ClientCore::State::vacate_all(
+    std::optional<std::uint32_t> to) {
+  std::vector<std::unique_ptr<PendingCall>> calls;
+  for (Slot& slot : slots) {
+    if (slot.sequence != 0 && (!to || slot.server == *to)) {
+      calls.push_back(vacate(slot.sequence, std::nullopt));
+    }
+  }
+  return calls;
+}
+
 void ClientCore::State::server_gone(std::uint32_t reply_publisher, const std::string& why) {
-  std::vector<Completion> failed;
+  std::vector<std::unique_ptr<PendingCall>> failed;
   std::shared_ptr<ServerWatch> stopped;
   {
     std::lock_guard lock(mutex);
@@ -184,19 +235,12 @@ void ClientCore::State::server_gone(std::uint32_t reply_publisher, const std::st
       current.reset();
       stopped = std::exchange(watch, nullptr);
     }
-    for (auto it = pending.begin(); it != pending.end();) {
-      if (it->second.server != reply_publisher) {
-        ++it;
-        continue;
-      }
-      failed.push_back(std::move(it->second.completion));
-      it = pending.erase(it);
-    }
+    failed = vacate_all(reply_publisher);
   }
   if (stopped) node->remove_waitable(stopped->key());
   const auto error = std::make_exception_ptr(ServiceUnavailable(
       "agnocast: service " + name + ": the server went away (" + why + ") before answering"));
-  for (auto& completion : failed) completion(nullptr, nullptr, error);
+  for (auto& call : failed) call->complete(nullptr, nullptr, error);
 }
 
 ClientCore::ClientCore(std::shared_ptr<NodeState> node, std::string_view service, const QoS& qos,
@@ -210,11 +254,11 @@ ClientCore::ClientCore(std::shared_ptr<NodeState> node, std::string_view service
 
 ClientCore::~ClientCore() {
   std::shared_ptr<ServerWatch> watch;
-  std::map<std::uint64_t, State::Pending> pending;
+  std::vector<std::unique_ptr<PendingCall>> abandoned;  // their futures break
   {
     std::lock_guard lock(state_->mutex);
     watch = std::exchange(state_->watch, nullptr);
-    pending.swap(state_->pending);  // their futures break: nothing will answer them here
+    abandoned = state_->vacate_all(std::nullopt);
   }
   if (watch) state_->node->remove_waitable(watch->key());
 }
@@ -223,27 +267,26 @@ const std::string& ClientCore::service_name() const { return state_->name; }
 
 std::size_t ClientCore::pending() const {
   std::lock_guard lock(state_->mutex);
-  return state_->pending.size();
+  return state_->bound - state_->free_slots.size();
 }
 
 std::size_t ClientCore::prune_pending() {
-  std::map<std::uint64_t, State::Pending> pruned;
+  std::vector<std::unique_ptr<PendingCall>> pruned;  // destroyed outside the lock
   {
     std::lock_guard lock(state_->mutex);
-    pruned.swap(state_->pending);
+    pruned = state_->vacate_all(std::nullopt);
   }
   return pruned.size();
 }
 
 bool ClientCore::forget(const RequestId& id) {
-  std::optional<State::Pending> forgotten;  // its completion dies outside the lock
-  std::lock_guard lock(state_->mutex);
-  if (id.client != state_->reply_subscriber) return false;
-  const auto it = state_->pending.find(id.sequence);
-  if (it == state_->pending.end()) return false;
-  forgotten = std::move(it->second);
-  state_->pending.erase(it);
-  return true;
+  std::unique_ptr<PendingCall> forgotten;  // destroyed outside the lock
+  {
+    std::lock_guard lock(state_->mutex);
+    if (id.client != state_->reply_subscriber) return false;
+    forgotten = state_->vacate(id.sequence, std::nullopt);
+  }
+  return forgotten != nullptr;
 }
 
 bool ClientCore::service_is_ready() const { return state_->server().has_value(); }
@@ -261,63 +304,100 @@ bool ClientCore::wait_for_service(std::chrono::nanoseconds timeout) const {
   }
 }
 
+namespace {
+
+class FunctionCall final : public PendingCall {
+ public:
+  explicit FunctionCall(ClientCore::Completion completion) : completion_(std::move(completion)) {}
+  void complete(const void* response, EntryReference* reference,
+                std::exception_ptr error) override {
+    completion_(response, reference, std::move(error));
+  }
+
+ private:
+  ClientCore::Completion completion_;
+};
+
+}  // namespace
+
 RequestId ClientCore::send(void* request, std::size_t bytes, Completion completion) {
+  std::unique_ptr<PendingCall> call;
+  try {
+    call = std::make_unique<FunctionCall>(std::move(completion));
+  } catch (...) {
+    discard_message(request);
+    throw;
+  }
+  return send(request, bytes, std::move(call));
+}
+
+RequestId ClientCore::send(void* request, std::size_t bytes, std::unique_ptr<PendingCall> call) {
   State& state = *state_;
+  const auto refuse_over_bound = [&] {
+    discard_message(request);
+    throw TooManyRequests("agnocast: service " + state.name + ": " + std::to_string(state.bound) +
+                          " requests are in flight already, the client's bound (its QoS "
+                          "depth); wait for answers or prune_pending_requests()");
+  };
+  const auto fail = [&](auto error) {
+    discard_message(request);
+    call->complete(nullptr, nullptr, std::make_exception_ptr(std::move(error)));
+  };
+  RequestId id{state.reply_subscriber, 0};
+  std::optional<Server> server;
   {
+    // The common case, one lock: a server known and watched (never one
+    // known gone: server_gone() forgets it under this lock).
     std::lock_guard lock(state.mutex);
-    if (state.pending.size() >= state.bound) {
-      discard_message(request);
-      throw TooManyRequests("agnocast: service " + state.name + ": " + std::to_string(state.bound) +
-                            " requests are in flight already, the client's bound (its QoS "
-                            "depth); wait for answers or prune_pending_requests()");
+    if (state.free_slots.empty()) refuse_over_bound();
+    if (state.current) {
+      server = state.current;
+      id.sequence = state.occupy(server->reply_publisher, call);
     }
   }
-  const auto fail = [&](auto error) {
-    completion(nullptr, nullptr, std::make_exception_ptr(std::move(error)));
-  };
-  const std::optional<Server> server = state.server();
-  RequestId id{state.reply_subscriber, 0};
   if (!server) {
-    discard_message(request);
-    fail(ServiceUnavailable("agnocast: service " + state.name + " has no server"));
-    return id;
-  }
-  {
-    std::lock_guard lock(state.mutex);
-    id.sequence = state.next_sequence++;
-    if (state.gone.contains(server->reply_publisher)) {
-      discard_message(request);
+    server = state.server();
+    if (!server) {
+      fail(ServiceUnavailable("agnocast: service " + state.name + " has no server"));
+      return id;
+    }
+    bool gone = false;
+    {
+      std::lock_guard lock(state.mutex);
+      gone = state.gone.contains(server->reply_publisher);
+      if (!gone && state.free_slots.empty()) refuse_over_bound();  // another thread took it
+      if (!gone) id.sequence = state.occupy(server->reply_publisher, call);
+    }
+    if (gone) {
       fail(ServiceUnavailable("agnocast: service " + state.name + ": the server went away"));
       return id;
     }
-    state.pending.emplace(id.sequence, State::Pending{server->reply_publisher, completion});
   }
   set_service_tag(request, ServiceTag{id.sequence, state.reply_subscriber, 0,
                                       static_cast<std::uint16_t>(ServiceStatus::request)});
   try {
     state.requests.publish(request, bytes, ServiceRoute{server->request_subscriber, true});
   } catch (const DeviceError& error) {
-    // publish() freed the request. Whoever takes the pending entry completes it.
-    std::optional<State::Pending> taken;
+    // publish() freed the request. Whoever takes the pending call completes it.
+    std::unique_ptr<PendingCall> taken;
     {
       std::lock_guard lock(state.mutex);
-      if (auto it = state.pending.find(id.sequence); it != state.pending.end()) {
-        taken = std::move(it->second);
-        state.pending.erase(it);
-      }
+      taken = state.vacate(id.sequence, std::nullopt);
     }
+    const auto fail_taken = [&](auto failure) {
+      if (taken) taken->complete(nullptr, nullptr, std::make_exception_ptr(std::move(failure)));
+    };
     switch (error.code()) {
       case ENXIO:  // the server's request subscriber is gone: so is the server
       case EPIPE:
         state.server_gone(server->reply_publisher, "its request subscriber is gone");
-        if (taken)
-          fail(ServiceUnavailable("agnocast: service " + state.name + ": the server went away"));
+        fail_taken(
+            ServiceUnavailable("agnocast: service " + state.name + ": the server went away"));
         break;
       case EAGAIN:
-        if (taken) {
-          fail(RequestRejected("agnocast: service " + state.name +
-                               ": the server's request queue is full; the request was not sent"));
-        }
+        fail_taken(
+            RequestRejected("agnocast: service " + state.name +
+                            ": the server's request queue is full; the request was not sent"));
         break;
       default:
         throw;
@@ -334,17 +414,12 @@ void ClientCore::deliver(const void* message, EntryReference* reference, const M
     state.server_gone(info.publisher_id, "it stopped");
     return;
   }
-  std::optional<State::Pending> answered;
-  {
-    std::lock_guard lock(state.mutex);
-    const auto it = state.pending.find(tag.sequence);
+  std::unique_ptr<PendingCall> answered;
+  if (tag.status == static_cast<std::uint16_t>(ServiceStatus::response) ||
+      tag.status == static_cast<std::uint16_t>(ServiceStatus::failed)) {
     // Only the server the request went to may answer it.
-    if ((tag.status == static_cast<std::uint16_t>(ServiceStatus::response) ||
-         tag.status == static_cast<std::uint16_t>(ServiceStatus::failed)) &&
-        it != state.pending.end() && it->second.server == info.publisher_id) {
-      answered = std::move(it->second);
-      state.pending.erase(it);
-    }
+    std::lock_guard lock(state.mutex);
+    answered = state.vacate(tag.sequence, info.publisher_id);
   }
   if (!answered) {
     release(reference);  // an answer to a pruned request
@@ -352,12 +427,12 @@ void ClientCore::deliver(const void* message, EntryReference* reference, const M
   }
   if (tag.status == static_cast<std::uint16_t>(ServiceStatus::failed)) {
     release(reference);
-    answered->completion(nullptr, nullptr,
-                         std::make_exception_ptr(ServiceUnavailable(
-                             "agnocast: service " + state.name + ": the server could not answer")));
+    answered->complete(nullptr, nullptr,
+                       std::make_exception_ptr(ServiceUnavailable(
+                           "agnocast: service " + state.name + ": the server could not answer")));
     return;
   }
-  answered->completion(message, reference, nullptr);
+  answered->complete(message, reference, nullptr);
 }
 
 }  // namespace agnocast::detail

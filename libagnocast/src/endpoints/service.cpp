@@ -115,7 +115,10 @@ void ServiceCore::deliver(const void* message, EntryReference* reference, const 
   {
     std::lock_guard lock(state.mutex);
     if (const auto known = state.clients.find(info.publisher_id); known != state.clients.end()) {
-      if (known->second == tag.peer) client = tag.peer;
+      if (known->second == tag.peer) {
+        client = tag.peer;
+        ++state.calls;
+      }
     }
   }
   if (!client && tag.status == static_cast<std::uint16_t>(ServiceStatus::request)) {
@@ -135,6 +138,7 @@ void ServiceCore::deliver(const void* message, EntryReference* reference, const 
       if (asking && named && asking->pid == named->pid) {
         state.clients[info.publisher_id] = tag.peer;
         client = tag.peer;
+        ++state.calls;
       }
     }
   }
@@ -146,10 +150,6 @@ void ServiceCore::deliver(const void* message, EntryReference* reference, const 
                                std::to_string(info.publisher_id) +
                                " that names no reply subscriber of its own process");
     return;
-  }
-  {
-    std::lock_guard lock(state.mutex);
-    ++state.calls;
   }
   handle_request(message, reference, RequestId{*client, tag.sequence});
 }

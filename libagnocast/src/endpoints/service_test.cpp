@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <future>
@@ -276,6 +277,45 @@ TEST_F(ServiceTest, DeferredResponsesAnswerTheRightRequestsInAnyOrder) {
   }
   EXPECT_EQ(client->handle_wakeup(), 3U);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(futures[i].get()->sum, 10 + i);
+}
+
+TEST_F(ServiceTest, ThousandsOfCallsAnsweredOutOfOrderEachReachTheirOwnFuture) {
+  Node node{"many"};
+  const std::string name = topic("many");
+  std::vector<std::pair<RequestId, ipc_shared_ptr<const Add::Request>>> kept;
+  auto server = node.create_service<Add>(name, [&](std::shared_ptr<Service<Add>>, RequestId id,
+                                                   ipc_shared_ptr<const Add::Request> request) {
+    kept.emplace_back(id, std::move(request));
+  });
+  constexpr int bound = 3;
+  auto client = node.create_client<Add>(name, QoS{bound});
+  std::int64_t wrong = 0, answered = 0;
+  for (int batch = 0; batch < 1000; ++batch) {
+    // A batch fills the bound; the server answers a rotation of it, so that
+    // each request's place among those in flight keeps changing.
+    for (int i = 0; i < bound; ++i) {
+      auto request = client->borrow_loaned_request();
+      request->a = batch;
+      request->b = i;
+      client->async_send_request(std::move(request), [&, batch, i](Future future) {
+        ++answered;
+        if (future.get()->sum != batch + i) ++wrong;
+      });
+    }
+    ASSERT_EQ(server->handle_wakeup(), static_cast<std::size_t>(bound));
+    std::rotate(kept.begin(), kept.begin() + batch % bound, kept.end());
+    for (auto& [id, request] : kept) {
+      auto response = server->borrow_loaned_response();
+      response->sum = request->a + request->b;
+      server->send_response(id, std::move(response));
+    }
+    kept.clear();
+    ASSERT_EQ(client->handle_wakeup(), static_cast<std::size_t>(bound));
+  }
+  EXPECT_EQ(answered, 1000 * bound);
+  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(client->pending(), 0U);
+  EXPECT_EQ(server->calls(), static_cast<std::uint64_t>(1000 * bound));
 }
 
 TEST_F(ServiceTest, AFailedRequestFailsItsFutureAloneAndLeavesNothingPending) {

@@ -69,10 +69,20 @@ class ServiceCore : public SubscriptionBase {
   std::unique_ptr<State> state_;
 };
 
+// One request's way back to its caller. complete() runs once, from the
+// executor or inside ClientCore::send(): with the response (its reference
+// count one, now the call's), or with error. A call never completed (pruned,
+// forgotten, its client destroyed) is only destroyed.
+class PendingCall {
+ public:
+  virtual ~PendingCall() = default;
+  virtual void complete(const void* response, EntryReference* reference,
+                        std::exception_ptr error) = 0;
+};
+
 class ClientCore : public SubscriptionBase {
  public:
-  // Runs once per request, from the executor or inside send(): with the
-  // response (its reference count one, now the completion's), or with error.
+  // A PendingCall's complete() as a function.
   using Completion = std::function<void(const void* response, EntryReference* reference,
                                         std::exception_ptr error)>;
 
@@ -84,7 +94,8 @@ class ClientCore : public SubscriptionBase {
 
   // Takes ownership of the loaned request. Throws TooManyRequests, with
   // nothing sent, when the in-flight bound is reached; every other failure
-  // reaches completion.
+  // reaches the call.
+  RequestId send(void* request, std::size_t bytes, std::unique_ptr<PendingCall> call);
   RequestId send(void* request, std::size_t bytes, Completion completion);
   bool service_is_ready() const;
   bool wait_for_service(std::chrono::nanoseconds timeout) const;

@@ -743,4 +743,54 @@ double BackgroundTraffic::delivered_per_s() const {
   return static_cast<double>(shared_->received.load() - received_at_start_) / seconds;
 }
 
+IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t topics) {
+  Pipe ready = Pipe::open(), release = Pipe::open();
+  release_fd_ = release.write_fd;
+  const std::string prefix = next_topic("idle");
+  std::size_t created = 0;
+  for (std::size_t p = 0; p < processes; ++p) {
+    // An even share of the topics, the first processes one more.
+    const std::size_t share = topics / processes + (p < topics % processes ? 1 : 0);
+    const std::size_t first = created;
+    created += share;
+    processes_.push_back(spawn([&] {
+      ::close(release.write_fd);  // the driver's copy alone holds the processes
+      agnocast::Node node{"bench_idle_" + std::to_string(p)};
+      std::vector<std::shared_ptr<agnocast::Publisher<BenchMessage>>> publishers;
+      publishers.reserve(share);
+      for (std::size_t t = first; t < first + share; ++t) {
+        publishers.push_back(node.create_publisher<BenchMessage>(prefix + "_" + std::to_string(t),
+                                                                 agnocast::QoS{10}));
+      }
+      char byte = 1;
+      write_all(ready.write_fd, &byte, 1);
+      read_all(release.read_fd, &byte, 1);  // end of file: released
+      return 0;
+    }));
+  }
+  release.close_read();
+  ready.close_write();
+  try {
+    read_bytes(ready.read_fd, processes);
+  } catch (...) {
+    ready.close_read();
+    release_all();
+    throw;
+  }
+  ready.close_read();
+}
+
+IdleEndpoints::~IdleEndpoints() { release_all(); }
+
+void IdleEndpoints::release_all() noexcept {
+  ::close(release_fd_);
+  for (pid_t process : processes_) {
+    try {
+      reap(process, "idle");
+    } catch (const std::exception& error) {
+      std::cerr << error.what() << "\n";
+    }
+  }
+}
+
 }  // namespace agnocast::bench

@@ -106,4 +106,21 @@ class BackgroundTraffic {
   std::uint64_t received_at_start_ = 0;
 };
 
+// What a large system has registered beside the measured topic, while it
+// lives: `processes` processes attached to agnocast, holding `topics` idle
+// topics between them (one publisher each, nothing ever published).
+class IdleEndpoints {
+ public:
+  IdleEndpoints(std::size_t processes, std::size_t topics);
+  ~IdleEndpoints();
+  IdleEndpoints(const IdleEndpoints&) = delete;
+  IdleEndpoints& operator=(const IdleEndpoints&) = delete;
+
+ private:
+  void release_all() noexcept;
+
+  int release_fd_ = -1;  // closing it lets every process go
+  std::vector<pid_t> processes_;
+};
+
 }  // namespace agnocast::bench

@@ -41,6 +41,14 @@ namespace {
 struct Plan {
   std::vector<std::size_t> sizes{64, 4 << 10, 1 << 20, 16 << 20, 64 << 20};
   std::vector<std::size_t> fanouts{1, 8, 64};
+  // icount mode's fan-out points: its rounds are cheap, and the publisher's
+  // publish() call is fitted over them.
+  std::vector<std::size_t> icount_fanouts{1, 2, 4, 8, 16, 32, 64};
+  // Scale: other topics registered (idle), and processes attached in all
+  // (the measured publisher and subscriber among them). In icount mode only:
+  // what they show is instructions, which the ordinary mode's noise hides.
+  std::vector<std::size_t> idle_topics{1, 100, 1000, 10000};
+  std::vector<std::size_t> attached_processes{2, 50, 200};
   // Request and response payloads of the service's round trip.
   std::vector<std::size_t> service_sizes{64, 4 << 20};
   std::size_t rounds = 20;
@@ -74,6 +82,8 @@ struct Plan {
     constant_bytes_samples = 1;
     fanout_samples = 1;
     service_sizes = {64};
+    idle_topics = {100};
+    attached_processes = {4};
     steady_messages = 30;
     throughput_count = 200;
   }
@@ -179,7 +189,10 @@ class Samples {
   // NaN when it has none.
   double round_p50(std::size_t round, const std::string& who, const std::string& label) const {
     if (round == all_rounds) {
-      return has(who, label) ? pooled(who, label).p50_us : std::numeric_limits<double>::quiet_NaN();
+      // A series whose every cell failed has rounds but no samples.
+      return has(who, label) && pooled(who, label).samples > 0
+                 ? pooled(who, label).p50_us
+                 : std::numeric_limits<double>::quiet_NaN();
     }
     auto found = by_round_.find({who, label});
     if (found == by_round_.end() || round >= found->second.size() || found->second[round].empty()) {
@@ -364,6 +377,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   const std::string small = bench::format_size(64), page = bench::format_size(4 << 10);
   struct SendCalls {
     std::vector<double> send_us;
+    std::vector<double> send_cpu_us;  // the sending thread's own CPU time in the call
     std::size_t delivered_first = 0;  // the receiver had it before the call returned
   };
   std::map<std::string, std::map<std::string, SendCalls>> send_calls;
@@ -434,6 +448,23 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                          }});
       }
     }
+    if (plan.icount || plan.smoke) {
+      for (std::size_t topics : plan.idle_topics) {
+        cells.push_back({"agnocast_beside_idle_topics", std::to_string(topics), [=](auto&) {
+                           // The module's default max_endpoints_per_process is
+                           // 1024: a process holds 1,000 of them at most.
+                           const bench::IdleEndpoints idle((topics + 999) / 1000, topics);
+                           return bench::run_agnocast_latency(64, n, 1).front();
+                         }});
+      }
+      for (std::size_t processes : plan.attached_processes) {
+        cells.push_back({"agnocast_with_processes_attached", std::to_string(processes), [=](auto&) {
+                           const std::size_t others = processes > 2 ? processes - 2 : 0;
+                           const bench::IdleEndpoints idle(others, others);
+                           return bench::run_agnocast_latency(64, n, 1).front();
+                         }});
+      }
+    }
     for (std::size_t subscribers : plan.fanouts) {
       const std::string label = std::to_string(subscribers);
       cells.push_back({"agnocast_fanout", label, [&, subscribers](auto&) {
@@ -453,7 +484,9 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       // sender's send call (one clock read after it returns), which the
       // roles append to a file: whether the receiver had the message before
       // it returned tells a stalled sender from a slow path.
-      const bool timed = !plan.icount && cell.who.ends_with("_constant_bytes");
+      // The fan-out series times the publisher's publish() too, in both modes.
+      const bool timed =
+          (!plan.icount && cell.who.ends_with("_constant_bytes")) || cell.who == "agnocast_fanout";
       if (timed) {
         std::remove(windows_path.c_str());
         setenv("AGNOCAST_BENCH_WINDOWS", "times", 1);
@@ -470,6 +503,9 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
           const auto& window = windows[windows.size() - measured.size() + i];
           if (!window.contains("send_ns")) continue;
           calls.send_us.push_back(static_cast<double>(window.at("send_ns")) / 1000);
+          if (window.contains("send_cpu_ns")) {
+            calls.send_cpu_us.push_back(static_cast<double>(window.at("send_cpu_ns")) / 1000);
+          }
           if (measured[i] < window.at("send_ns")) ++calls.delivered_first;
         }
       }
@@ -481,8 +517,13 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   // Series in a fixed order, sizes and subscriber counts ascending.
   const std::string smallest_label = bench::format_size(plan.sizes.front());
   const std::string largest_label = bench::format_size(plan.sizes.back());
-  std::vector<std::string> size_labels, fanout_labels, service_labels;
+  std::vector<std::string> size_labels, fanout_labels, service_labels, topics_labels,
+      processes_labels;
   for (std::size_t size : plan.sizes) size_labels.push_back(bench::format_size(size));
+  for (std::size_t topics : plan.idle_topics) topics_labels.push_back(std::to_string(topics));
+  for (std::size_t processes : plan.attached_processes) {
+    processes_labels.push_back(std::to_string(processes));
+  }
   for (std::size_t size : plan.service_sizes) service_labels.push_back(bench::format_size(size));
   for (std::size_t subscribers : plan.fanouts) fanout_labels.push_back(std::to_string(subscribers));
   const std::vector<std::pair<std::string, std::vector<std::string>>> series{
@@ -500,6 +541,8 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       {"agnocast_service", service_labels},
       {"agnocast_ping_pong", {small}},
       {"unix_socket_request_response", {"1 B"}},
+      {"agnocast_beside_idle_topics", topics_labels},
+      {"agnocast_with_processes_attached", processes_labels},
   };
   for (const auto& [who, labels] : series) {
     for (const auto& label : labels) {
@@ -528,6 +571,9 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       report["send_call"][who][label] = {{"samples", calls.send_us.size()},
                                          {"p50_us", bench::median(calls.send_us)},
                                          {"delivered_before_it_returned", calls.delivered_first}};
+      if (!calls.send_cpu_us.empty()) {
+        report["send_call"][who][label]["cpu_p50_us"] = bench::median(calls.send_cpu_us);
+      }
     }
   }
   report["failed_cells"] = failed_cells;
@@ -586,7 +632,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
        [&](std::size_t r) {
          return p50(r, "agnocast_beside_63_busy_topics", small) / p50(r, "agnocast", small);
        }},
-      {"fanout_slope", 1.2, 1.5,
+      {"fanout_slope", 1.2, 1.2,
        [&](std::size_t r) { return slope(r, "agnocast_fanout") / slope(r, "mqueue_fanout"); }},
       {"fanout_64", 64.0, 64.0,
        [&](std::size_t r) {
@@ -596,6 +642,18 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       {"service_vs_one_way", 2.2, 2.2,
        [&](std::size_t r) {
          return p50(r, "agnocast_service", small) / p50(r, "agnocast", small);
+       }},
+      {"idle_topics_flatness", not_in_mode, 1.02,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_beside_idle_topics", std::to_string(plan.idle_topics.back())) /
+                p50(r, "agnocast_beside_idle_topics", std::to_string(plan.idle_topics.front()));
+       }},
+      {"attached_processes_flatness", not_in_mode, 1.02,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_with_processes_attached",
+                    std::to_string(plan.attached_processes.back())) /
+                p50(r, "agnocast_with_processes_attached",
+                    std::to_string(plan.attached_processes.front()));
        }},
       {"service_size_flatness", 1.02, 1.02,
        [&](std::size_t r) {
@@ -632,6 +690,28 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
     }
     report["targets"][ratio.name] = ratio.target;
     report["ratio_rounds"][ratio.name] = estimate.rounds;
+  }
+  // The publisher's own time in its publish() call (its thread's CPU time:
+  // on one vCPU the subscribers it wakes may run inside the call) against
+  // the subscribers it wakes: a least-squares line through the fan-out
+  // points' p50s.
+  if (report.contains("send_call") && report["send_call"].contains("agnocast_fanout")) {
+    double n = 0, sum_x = 0, sum_y = 0, sum_xx = 0, sum_xy = 0;
+    for (std::size_t subscribers : plan.fanouts) {
+      const json& call = report["send_call"]["agnocast_fanout"][std::to_string(subscribers)];
+      if (!call.is_object() || !call.contains("cpu_p50_us")) continue;
+      const double x = static_cast<double>(subscribers), y = call["cpu_p50_us"].get<double>();
+      n += 1;
+      sum_x += x;
+      sum_y += y;
+      sum_xx += x * x;
+      sum_xy += x * y;
+    }
+    if (n >= 2 && n * sum_xx != sum_x * sum_x) {
+      const double per_subscriber = (n * sum_xy - sum_x * sum_y) / (n * sum_xx - sum_x * sum_x);
+      report["publish_call_us"] = {{"base", (sum_y - per_subscriber * sum_x) / n},
+                                   {"per_subscriber", per_subscriber}};
+    }
   }
   std::vector<double> agnocast_slopes, mqueue_slopes;
   for (std::size_t round = 0; round < plan.rounds; ++round) {
@@ -720,6 +800,40 @@ int repeat_check(std::size_t samples, double tolerance) {
   std::printf("agnocast 64 B p50: %.0f ns, then %.0f ns: %.3f %% apart (at most %.1f %%)\n",
               p50s[0], p50s[1], difference * 100, tolerance * 100);
   return difference <= tolerance ? 0 : 1;
+}
+
+// Nothing on the message path grows with what else is registered: agnocast's
+// 64 B p50 beside 1 and 1,000 idle topics, and with 2 and 50 processes
+// attached, each pair within `tolerance`. In icount mode the p50s are
+// instruction counts, so this checks the scale series' slope, not a timing.
+int scale_check(std::size_t samples, double tolerance) {
+  auto p50_beside = [&](std::size_t processes, std::size_t topics) {
+    const Cell cell{"agnocast", "64 B", [=](auto&) {
+                      const bench::IdleEndpoints idle(processes, topics);
+                      return bench::run_agnocast_latency(64, samples, 1).front();
+                    }};
+    std::vector<std::int64_t> measured, extra;
+    if (!run_isolated(cell, 300, measured, extra)) return std::numeric_limits<double>::quiet_NaN();
+    return bench::summarize(measured).p50_us * 1000;
+  };
+  struct Pair {
+    const char* what;
+    double small, large;
+  };
+  const Pair pairs[] = {
+      {"1 -> 1,000 idle topics", p50_beside(1, 1), p50_beside(1, 1000)},
+      {"2 -> 50 processes attached", p50_beside(0, 0), p50_beside(48, 48)},
+  };
+  int status = 0;
+  for (const Pair& pair : pairs) {
+    const double growth = pair.large / pair.small - 1;
+    const bool flat = std::isfinite(growth) && std::abs(growth) <= tolerance;
+    std::printf("agnocast 64 B p50, %s: %.0f ns, then %.0f ns: %+.3f %% (at most %.1f %%): %s\n",
+                pair.what, pair.small, pair.large, growth * 100, tolerance * 100,
+                flat ? "flat" : "NOT FLAT");
+    if (!flat) status = 1;
+  }
+  return status;
 }
 
 // The 64 B series of agnocast, iceoryx, the mqueue floors and the Unix socket,
@@ -860,6 +974,11 @@ int main(int argc, char** argv) {
   app.add_flag("--repeat-check", repeat,
                "measure agnocast's 64 B p50 twice; fail if they differ by more than 1 % (a check "
                "of icount mode's repeatability)");
+  bool scale = false;
+  app.add_flag("--scale-check", scale,
+               "measure agnocast's 64 B p50 beside 1 and 1,000 idle topics, and with 2 and 50 "
+               "processes attached; fail if a pair differs by more than 2 % (in icount mode: "
+               "nothing on the message path grows with them)");
   bool windows = false, window_counters = false;
   app.add_flag("--window-counters", window_counters,
                "with --window-check: the kernel's counters too, which cost time themselves");
@@ -907,9 +1026,11 @@ int main(int argc, char** argv) {
     std::cerr << "agnocast-bench: could not start again without address randomization\n";
   }
   if (repeat) return repeat_check(plan.latency_samples, 0.01);
+  if (scale) return scale_check(plan.latency_samples, 0.02);
   if (windows) return window_check(plan, iceoryx_role, window_counters);
   if (smoke) plan.make_smoke();
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
+  if (plan.icount && !smoke) plan.fanouts = plan.icount_fanouts;
   try {
     json report = run(plan, iceoryx_role, breakdown_program, cli, python);
     // A smoke run's findings come before the report, where a log's reader

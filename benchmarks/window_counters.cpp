@@ -4,6 +4,7 @@
 #include <linux/perf_event.h>
 #include <sched.h>
 #include <sys/ioctl.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -118,9 +119,16 @@ SampleWindows::SampleWindows(std::string who) : who_(std::move(who)) {
   if (!counters_) std::fprintf(stderr, "agnocast-bench: no window counters: %s\n", why.c_str());
 }
 
+std::int64_t SampleWindows::thread_cpu_ns() {
+  timespec now{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
+
 void SampleWindows::start() {
   if (counters_) before_ = counters_->read();
   cpu_ = sched_getcpu();
+  start_cpu_ns_ = thread_cpu_ns();
   start_ns_ = now_ns();
 }
 
@@ -130,6 +138,7 @@ void SampleWindows::record(std::uint64_t seq) {
       counters_ ? counters_between(before_, counters_->read()) : std::vector<std::int64_t>{};
   std::string line = "window " + who_ + " seq=" + std::to_string(seq) +
                      " cpu=" + std::to_string(cpu_) + " send_ns=" + std::to_string(send_ns_) +
+                     " send_cpu_ns=" + std::to_string(send_cpu_ns_) +
                      " acked_ns=" + std::to_string(acked_ns);
   for (std::size_t i = 0; i < delta.size(); ++i) {
     line += " " + counters_->names()[i] + "=" + std::to_string(delta[i]);

@@ -41,11 +41,12 @@ std::vector<std::int64_t> counters_between(const std::vector<std::int64_t>& befo
                                            const std::vector<std::int64_t>& after);
 
 // A sender's record of its samples' windows: the counters read right before
-// the clock starts and again once the receiver has acked, and how long the
-// send call took, one line per sample ("window WHO seq=N send_ns=... name=value
-// ..."), appended to the file AGNOCAST_BENCH_WINDOWS_FILE names (or stderr):
-// the times when AGNOCAST_BENCH_WINDOWS is set, the counters too when it is
-// "counters".
+// the clock starts and again once the receiver has acked, how long the send
+// call took and how much of that the sending thread itself ran (its CPU time:
+// on one CPU, receivers woken inside the call run inside it too), one line per
+// sample ("window WHO seq=N send_ns=... send_cpu_ns=... name=value ..."), appended to the file
+// AGNOCAST_BENCH_WINDOWS_FILE names (or stderr): the times when AGNOCAST_BENCH_WINDOWS is set, the
+// counters too when it is "counters".
 class SampleWindows {
  public:
   explicit SampleWindows(std::string who);
@@ -55,7 +56,10 @@ class SampleWindows {
     if (timed_) start();
   }
   void sent() {
-    if (timed_) send_ns_ = now_ns() - start_ns_;
+    if (timed_) {
+      send_ns_ = now_ns() - start_ns_;
+      send_cpu_ns_ = thread_cpu_ns() - start_cpu_ns_;
+    }
   }
   void after_ack(std::uint64_t seq) {
     if (timed_) record(seq);
@@ -64,11 +68,12 @@ class SampleWindows {
  private:
   void start();
   void record(std::uint64_t seq);
+  static std::int64_t thread_cpu_ns();
   std::string who_;
   bool timed_ = false;
   std::optional<WindowCounters> counters_;
   std::vector<std::int64_t> before_;
-  std::int64_t start_ns_ = 0, send_ns_ = 0;
+  std::int64_t start_ns_ = 0, send_ns_ = 0, start_cpu_ns_ = 0, send_cpu_ns_ = 0;
   int cpu_ = -1;
 };
 

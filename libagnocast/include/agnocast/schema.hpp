@@ -86,6 +86,9 @@ void require_native_layout(const ContainerLayout& layout, std::string_view type_
 
 // Bytes of one number or bool of this kind; 0 for strings, messages and opaque bytes.
 std::uint32_t primitive_size(FieldKind kind);
+// The .msg name of a primitive kind ("int32", "string"); nullptr for messages
+// and opaque bytes.
+const char* primitive_name(FieldKind kind);
 
 // The blob for a type and everything nested in it, with each type's .msg
 // text; without the texts when they would not fit. Throws SchemaError when

@@ -19,40 +19,6 @@ using nlohmann::json;
 // while it is parsed, before it costs memory or stack.
 constexpr int json_depth_max = 2 * static_cast<int>(message_max_nesting) + 2;
 
-const char* kind_name(FieldKind kind) {
-  switch (kind) {
-    case FieldKind::Bool:
-      return "bool";
-    case FieldKind::Int8:
-      return "int8";
-    case FieldKind::UInt8:
-      return "uint8";
-    case FieldKind::Int16:
-      return "int16";
-    case FieldKind::UInt16:
-      return "uint16";
-    case FieldKind::Int32:
-      return "int32";
-    case FieldKind::UInt32:
-      return "uint32";
-    case FieldKind::Int64:
-      return "int64";
-    case FieldKind::UInt64:
-      return "uint64";
-    case FieldKind::Float32:
-      return "float32";
-    case FieldKind::Float64:
-      return "float64";
-    case FieldKind::String:
-      return "string";
-    case FieldKind::Message:
-      return "message";
-    case FieldKind::Opaque:
-      break;
-  }
-  return "opaque bytes";
-}
-
 // What the user wrote, short enough for one line.
 std::string shown(const json& value) {
   std::string text = value.dump();
@@ -214,10 +180,11 @@ class JsonToCdr {
         fits = std::in_range<T>(given);
         number = static_cast<T>(given);
       } else {
-        fail(std::string("takes an integer (") + kind_name(field.kind) + "), not " + shown(*value));
+        fail(std::string("takes an integer (") + primitive_name(field.kind) + "), not " +
+             shown(*value));
       }
       if (!fits) {
-        fail(shown(*value) + " does not fit " + kind_name(field.kind) + " (" +
+        fail(shown(*value) + " does not fit " + primitive_name(field.kind) + " (" +
              std::to_string(std::numeric_limits<T>::min()) + " to " +
              std::to_string(std::numeric_limits<T>::max()) + ")");
       }
@@ -230,13 +197,15 @@ class JsonToCdr {
     T number = 0;
     if (value) {
       if (!value->is_number()) {
-        fail(std::string("takes a number (") + kind_name(field.kind) + "), not " + shown(*value));
+        fail(std::string("takes a number (") + primitive_name(field.kind) + "), not " +
+             shown(*value));
       }
       // Rounded to the nearest T: what rounds to infinity does not fit (IEEE
       // types reach infinity, so the conversion itself is defined).
       const double given = value->get<double>();
       number = static_cast<T>(given);
-      if (!std::isfinite(number)) fail(shown(*value) + " does not fit " + kind_name(field.kind));
+      if (!std::isfinite(number))
+        fail(shown(*value) + " does not fit " + primitive_name(field.kind));
     }
     writer_.write(number);
   }

@@ -45,8 +45,9 @@ struct Plan {
   // publish() call is fitted over them.
   std::vector<std::size_t> icount_fanouts{1, 2, 4, 8, 16, 32, 64};
   // Scale: other topics registered (idle), and processes attached in all
-  // (the measured publisher and subscriber among them). In icount mode only:
-  // what they show is instructions, which the ordinary mode's noise hides.
+  // (the measured publisher and subscriber among them). In icount mode (a
+  // smoke run measures their smallest points): what they show is
+  // instructions, which the ordinary mode's noise hides.
   std::vector<std::size_t> idle_topics{1, 100, 1000, 10000};
   std::vector<std::size_t> attached_processes{2, 50, 200};
   // Request and response payloads of the service's round trip.

@@ -43,10 +43,11 @@ std::vector<std::int64_t> counters_between(const std::vector<std::int64_t>& befo
 // A sender's record of its samples' windows: the counters read right before
 // the clock starts and again once the receiver has acked, how long the send
 // call took and how much of that the sending thread itself ran (its CPU time:
-// on one CPU, receivers woken inside the call run inside it too), one line per
-// sample ("window WHO seq=N send_ns=... send_cpu_ns=... name=value ..."), appended to the file
-// AGNOCAST_BENCH_WINDOWS_FILE names (or stderr): the times when AGNOCAST_BENCH_WINDOWS is set, the
-// counters too when it is "counters".
+// on one CPU, receivers woken inside the call run inside it too), one line
+// per sample ("window WHO seq=N send_ns=... send_cpu_ns=... name=value ..."),
+// appended to the file AGNOCAST_BENCH_WINDOWS_FILE names (or stderr): the
+// times when AGNOCAST_BENCH_WINDOWS is set, the counters too when it is
+// "counters".
 class SampleWindows {
  public:
   explicit SampleWindows(std::string who);

@@ -145,6 +145,7 @@ class Client : public detail::ClientCore {
     send(loaned, detail::published_bytes(loaned, sizeof(Request)), std::move(call));
     return future;
   }
+
   template <class Rep, class Period>
   bool wait_for_service(std::chrono::duration<Rep, Period> timeout) const {
     return ClientCore::wait_for_service(

@@ -15,58 +15,14 @@
 #include "agnocast/naming.hpp"
 #include "agnocast/node.hpp"
 #include "kernel/fake_runtime.hpp"
-
-namespace service_test {
-struct AddRequest {
-  std::int64_t a = 0;
-  std::int64_t b = 0;
-};
-struct AddResponse {
-  std::int64_t sum = 0;
-};
-struct Add {
-  using Request = AddRequest;
-  using Response = AddResponse;
-};
-// The same name with another response layout.
-struct WideResponse {
-  std::int64_t sum = 0;
-  std::int64_t carry = 0;
-};
-struct Wide {
-  using Request = AddRequest;
-  using Response = WideResponse;
-};
-}  // namespace service_test
-
-AGNOCAST_MESSAGE(service_test::AddRequest, "service_test/srv/Add_Request", a, b);
-AGNOCAST_MESSAGE(service_test::AddResponse, "service_test/srv/Add_Response", sum);
-AGNOCAST_MESSAGE(service_test::WideResponse, "service_test/srv/Add_Response", sum, carry);
-
-template <>
-struct agnocast::service_traits<service_test::Add> {
-  static constexpr bool is_declared = true;
-  static constexpr std::string_view type_name = "service_test/srv/Add";
-  static constexpr std::uint64_t request_type_hash =
-      message_traits<service_test::AddRequest>::type_hash;
-  static constexpr std::uint64_t response_type_hash =
-      message_traits<service_test::AddResponse>::type_hash;
-};
-
-template <>
-struct agnocast::service_traits<service_test::Wide> {
-  static constexpr bool is_declared = true;
-  static constexpr std::string_view type_name = "service_test/srv/Add";
-  static constexpr std::uint64_t request_type_hash =
-      message_traits<service_test::AddRequest>::type_hash;
-  static constexpr std::uint64_t response_type_hash =
-      message_traits<service_test::WideResponse>::type_hash;
-};
+#include "schema/schema_service_test_types.hpp"
 
 namespace agnocast::detail {
 namespace {
 
-using service_test::Add;
+// Sum's request adds a and b; its response's sum is what this file's
+// servers answer.
+using Add = schema_service_test::Sum;
 using ServiceTest = FakeRuntimeTest;
 using Future = Client<Add>::SharedFuture;
 
@@ -252,7 +208,7 @@ TEST_F(ServiceTest, AClientOfAnotherResponseTypeIsRefused) {
   Node node{"types"};
   const std::string name = topic("typed");
   auto service = node.create_service<Add>(name, adder());
-  EXPECT_THROW(node.create_client<service_test::Wide>(name), TypeMismatch);
+  EXPECT_THROW(node.create_client<schema_service_test::Wide>(name), TypeMismatch);
 }
 
 TEST_F(ServiceTest, DeferredResponsesAnswerTheRightRequestsInAnyOrder) {

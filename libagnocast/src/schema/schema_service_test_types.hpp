@@ -1,5 +1,5 @@
-// A service type for the tests of SchemaClient and SchemaService, declared
-// as agnocast-msggen would generate it.
+// A service type for the tests of services (Service and Client, SchemaClient
+// and SchemaService), declared as agnocast-msggen would generate it.
 #pragma once
 
 #include <cstdint>

@@ -29,6 +29,7 @@
 #include "baselines.hpp"
 #include "bench_support.hpp"
 #include "iceoryx_runner.hpp"
+#include "readme_plots.hpp"
 #include "recording.hpp"
 #include "report_shape.hpp"
 #include "round_estimate.hpp"
@@ -991,14 +992,23 @@ int main(int argc, char** argv) {
   app.add_option("--render", render,
                  "measure nothing: print a saved --json report as Markdown tables");
   std::string readme;
-  app.add_option("--readme", readme,
-                 "measure nothing: print benchmarks/README.md from a report of both modes");
+  auto* readme_option =
+      app.add_option("--readme", readme,
+                     "measure nothing: print benchmarks/README.md from a report of both modes");
+  std::string plots;
+  app.add_option("--plots", plots,
+                 "with --readme: write the README's plots (SVG) into this folder and link them "
+                 "as FOLDER-NAME/PLOT.svg, for a README beside the folder")
+      ->needs(readme_option);
   CLI11_PARSE(app, argc, argv);
 
   if (!readme.empty()) {
     std::ifstream saved(readme);
     try {
-      bench::print_readme(json::parse(saved));
+      const json combined = json::parse(saved);
+      std::map<std::string, bench::PlotLinks> links;
+      if (!plots.empty()) links = bench::write_readme_plots(combined, plots);
+      bench::print_readme(combined, links);
     } catch (const std::exception& error) {
       std::cerr << "agnocast-bench: " << readme << ": " << error.what() << "\n";
       return 1;

@@ -3,19 +3,25 @@
 // on any error listed here; speed is never judged.
 #pragma once
 
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "readme_plots.hpp"
 
 namespace agnocast::bench {
 
 std::vector<std::string> report_shape_errors(const nlohmann::ordered_json& report);
 
-// The report as the Markdown tables the README shows.
-void print_markdown(const nlohmann::ordered_json& report);
+// The report as the Markdown tables the README shows, each followed by its
+// plot's image line in `plots`, if any.
+void print_markdown(const nlohmann::ordered_json& report, const PlotLinks& plots = {});
 
 // benchmarks/README.md from one report of both modes ({"icount": report,
-// "ordinary": report, ...}, as scripts/bench --write-readme keeps it).
-void print_readme(const nlohmann::ordered_json& combined);
+// "ordinary": report, ...}, as scripts/bench --write-readme keeps it), with
+// each mode's plots (write_readme_plots).
+void print_readme(const nlohmann::ordered_json& combined,
+                  const std::map<std::string, PlotLinks>& plots = {});
 
 }  // namespace agnocast::bench

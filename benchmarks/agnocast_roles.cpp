@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <agnocast/agnocast.hpp>
+#include <agnocast/inspect.hpp>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -86,8 +87,11 @@ void read_bytes(int fd, std::size_t count) {
 
 std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, std::size_t count,
                                                             std::size_t subscribers,
-                                                            std::size_t scratch_bytes) {
-  const std::string topic = next_topic("latency");
+                                                            const LatencyOptions& options) {
+  const std::string topic = options.topic.empty() ? next_topic("latency") : options.topic;
+  const std::size_t scratch_bytes = options.scratch_bytes;
+  const agnocast::QoS publisher_qos{options.depth.value_or(1)};
+  const agnocast::QoS subscriber_qos{options.depth.value_or(10)};
   const std::size_t total = warmup_messages + count;
   // With several subscribers only the last delivery counts, and on one vCPU
   // (icount) every earlier subscriber's work before it sleeps delays it: so
@@ -127,7 +131,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
       agnocast::ipc_shared_ptr<const BenchMessage> unchecked;
       std::int64_t unchecked_latency = 0;
       auto subscription = node.create_subscription<BenchMessage>(
-          topic, agnocast::QoS{10}, [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
+          topic, subscriber_qos, [&](const agnocast::ipc_shared_ptr<const BenchMessage>& m) {
             std::int64_t t1 = now_ns();
             if (check_after_window) {
               unchecked = m;
@@ -159,7 +163,7 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   }
   pid_t publisher = spawn([&] {
     agnocast::Node node{"bench_publisher"};
-    auto pub = node.create_publisher<BenchMessage>(topic, agnocast::QoS{1});
+    auto pub = node.create_publisher<BenchMessage>(topic, publisher_qos);
     std::shared_ptr<agnocast::Publisher<BenchMessage>> check;
     if (check_after_window)
       check = node.create_publisher<BenchMessage>(check_topic, agnocast::QoS{1});
@@ -206,6 +210,92 @@ std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, st
   for (pid_t pid : subscriber_pids) reap(pid, "subscriber");
   munmap(shared, sizeof(std::atomic<std::uint32_t>));
   return per_subscriber;
+}
+
+std::vector<std::int64_t> run_agnocast_publish_call(std::size_t depth, std::size_t subscribers,
+                                                    std::size_t count, bool queue_full) {
+  if (!queue_full && subscribers != 1) {
+    throw std::invalid_argument("a queue that is never full has one subscriber here");
+  }
+  const std::string topic = next_topic("publish_call");
+  const agnocast::QoS qos{depth};
+  constexpr std::size_t per_process = 1000;
+  const std::size_t local = std::min(subscribers, per_process);
+  // The other subscribers, in processes of their own until released.
+  Pipe ready = Pipe::open(), release = Pipe::open();
+  std::vector<pid_t> holders;
+  for (std::size_t first = local; first < subscribers; first += per_process) {
+    const std::size_t share = std::min(per_process, subscribers - first);
+    holders.push_back(spawn([&, share] {
+      ::close(release.write_fd);
+      agnocast::Node node{"bench_full_queues"};
+      std::vector<std::shared_ptr<agnocast::PollingSubscriber<BenchMessage>>> held;
+      for (std::size_t s = 0; s < share; ++s) {
+        held.push_back(node.create_polling_subscriber<BenchMessage>(topic, qos));
+      }
+      char byte = 1;
+      write_all(ready.write_fd, &byte, 1);
+      read_all(release.read_fd, &byte, 1);  // end of file: released
+      return 0;
+    }));
+  }
+  release.close_read();
+  ready.close_write();
+  Pipe results = Pipe::open();
+  pid_t publisher = spawn([&] {
+    agnocast::Node node{"bench_publish_call"};
+    std::vector<std::shared_ptr<agnocast::PollingSubscriber<BenchMessage>>> polling;
+    for (std::size_t s = 0; s < local; ++s) {
+      polling.push_back(node.create_polling_subscriber<BenchMessage>(topic, qos));
+    }
+    auto pub = node.create_publisher<BenchMessage>(topic, qos);
+    read_bytes(ready.read_fd, holders.size());
+    // Fills every queue first (and maps and warms the pool).
+    const std::size_t filling = (queue_full ? depth : 0) + warmup_messages;
+    std::vector<std::int64_t> calls;
+    calls.reserve(count);
+    for (std::size_t seq = 0; seq < filling + count; ++seq) {
+      auto message = pub->borrow_loaned_message();
+      message->payload.resize(64);
+      message->seq = seq;
+      const std::int64_t t0 = now_ns();
+      pub->publish(std::move(message));
+      const std::int64_t t1 = now_ns();
+      if (seq >= filling) calls.push_back(t1 - t0);
+      if (!queue_full) {
+        auto taken = polling.front()->take_new_data();
+        if (!taken || taken->seq != seq)
+          throw std::runtime_error("a taken message is not the last");
+      }
+    }
+    // The kernel's word for it: each queue as full as its depth, and
+    // everything beyond the depth dropped, or nothing left and nothing dropped.
+    const std::optional<agnocast::TopicInfo> info = agnocast::topic_info(topic);
+    if (!info || info->subscribers.size() != subscribers) {
+      throw std::runtime_error("the topic lost subscribers");
+    }
+    for (const agnocast::SubscriberInfo& subscriber : info->subscribers) {
+      const std::size_t unreceived = queue_full ? depth : 0;
+      const std::size_t dropped = queue_full ? filling + count - depth : 0;
+      if (subscriber.unreceived != unreceived || subscriber.dropped != dropped) {
+        throw std::runtime_error("subscriber " + std::to_string(subscriber.id) + " has " +
+                                 std::to_string(subscriber.unreceived) + " unreceived, " +
+                                 std::to_string(subscriber.dropped) + " dropped; expected " +
+                                 std::to_string(unreceived) + ", " + std::to_string(dropped));
+      }
+    }
+    send_latencies(results.write_fd, calls);
+    return 0;
+  });
+  ready.close_read();
+  results.close_write();
+  std::vector<std::int64_t> calls = receive_latencies(results.read_fd);
+  results.close_read();
+  ::close(release.write_fd);
+  reap(publisher, "publisher");
+  for (pid_t holder : holders) reap(holder, "subscriber");
+  if (calls.size() != count) throw std::runtime_error("the publisher missed calls");
+  return calls;
 }
 
 namespace {
@@ -514,12 +604,7 @@ Throughput run_agnocast_throughput(std::size_t size, std::size_t count) {
   }
   reap(publisher, "publisher");
   reap(subscriber, "subscriber");
-  Throughput result;
-  result.published = count;
-  result.received = static_cast<std::uint64_t>(numbers[2]);
-  double seconds = static_cast<double>(numbers[1] - numbers[0]) / 1e9;
-  result.messages_per_s = seconds > 0 ? static_cast<double>(result.received) / seconds : 0;
-  return result;
+  return throughput_of(numbers[0], numbers[1], static_cast<std::uint64_t>(numbers[2]), count);
 }
 
 namespace {
@@ -743,24 +828,32 @@ double BackgroundTraffic::delivered_per_s() const {
   return static_cast<double>(shared_->received.load() - received_at_start_) / seconds;
 }
 
-IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t topics) {
+IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t topics)
+    : IdleEndpoints(processes, topics, [prefix = next_topic("idle")](std::size_t t) {
+        return prefix + "_" + std::to_string(t);
+      }) {}
+
+IdleEndpoints IdleEndpoints::publishers_of(const std::string& topic, std::size_t publishers) {
+  return IdleEndpoints((publishers + 999) / 1000, publishers, [&](std::size_t) { return topic; });
+}
+
+IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t publishers,
+                             const std::function<std::string(std::size_t)>& topic_of) {
   Pipe ready = Pipe::open(), release = Pipe::open();
   release_fd_ = release.write_fd;
-  const std::string prefix = next_topic("idle");
   std::size_t created = 0;
   for (std::size_t p = 0; p < processes; ++p) {
-    // An even share of the topics, the first processes one more.
-    const std::size_t share = topics / processes + (p < topics % processes ? 1 : 0);
+    // An even share of the publishers, the first processes one more.
+    const std::size_t share = publishers / processes + (p < publishers % processes ? 1 : 0);
     const std::size_t first = created;
     created += share;
     processes_.push_back(spawn([&] {
       ::close(release.write_fd);  // the driver's copy alone holds the processes
       agnocast::Node node{"bench_idle_" + std::to_string(p)};
-      std::vector<std::shared_ptr<agnocast::Publisher<BenchMessage>>> publishers;
-      publishers.reserve(share);
+      std::vector<std::shared_ptr<agnocast::Publisher<BenchMessage>>> idle;
+      idle.reserve(share);
       for (std::size_t t = first; t < first + share; ++t) {
-        publishers.push_back(node.create_publisher<BenchMessage>(prefix + "_" + std::to_string(t),
-                                                                 agnocast::QoS{10}));
+        idle.push_back(node.create_publisher<BenchMessage>(topic_of(t), agnocast::QoS{10}));
       }
       char byte = 1;
       write_all(ready.write_fd, &byte, 1);

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,15 +17,36 @@
 
 namespace agnocast::bench {
 
+// How a one-way latency run differs from the plain one.
+struct LatencyOptions {
+  // Bytes of private memory the publisher writes before each message: a
+  // control for what writing a large payload does to the caches, apart from
+  // the payload's size itself.
+  std::size_t scratch_bytes = 0;
+  // Both sides' QoS depth; by default the publisher keeps 1 message and each
+  // subscriber 10.
+  std::optional<std::size_t> depth{};
+  // The topic; by default one of its own.
+  std::string topic{};
+};
 // One-way latency of `count` messages of `size` payload bytes to each of
 // `subscribers` callback subscribers, one message in flight at a time; the
 // result holds one latency vector per subscriber (warm-up messages removed).
-// With scratch_bytes, the publisher also writes that many bytes of private
-// memory before each message: a control for what writing a large payload
-// does to the caches, apart from the payload's size itself.
 std::vector<std::vector<std::int64_t>> run_agnocast_latency(std::size_t size, std::size_t count,
                                                             std::size_t subscribers,
-                                                            std::size_t scratch_bytes = 0);
+                                                            const LatencyOptions& options = {});
+
+// The publisher's publish() call (wall time, one 64 B message each) on a
+// topic whose `subscribers` polling subscribers, like the publisher, have
+// QoS depth `depth`.  With `queue_full` no subscriber ever takes: each holds
+// `depth` unreceived entries, so every publish drops each one's oldest (and
+// the publisher reclaims what no one holds); the kernel's counters are checked
+// to say so afterwards.  Without, the one subscriber (`subscribers` must be 1)
+// takes each message before the next.  The subscribers share the publisher's
+// process, up to 1,000 of them (the module's default endpoints per process is
+// 1,024); the rest live in processes of their own.
+std::vector<std::int64_t> run_agnocast_publish_call(std::size_t depth, std::size_t subscribers,
+                                                    std::size_t count, bool queue_full);
 
 // Request to response: `count` round trips of a service whose request and
 // response each carry `size` payload bytes, from async_send_request() (the
@@ -55,12 +77,9 @@ struct PythonSubscriber {
 std::vector<std::int64_t> run_python_latency(const PythonSubscriber& python, std::size_t size,
                                              std::size_t count, std::size_t scratch_bytes);
 
-struct Throughput {
-  double messages_per_s = 0;
-  std::uint64_t received = 0;
-  std::uint64_t published = 0;
-};
-// `count` small messages published back to back to one subscriber.
+// `count` messages of `size` payload bytes published back to back (each
+// one's payload written) to one subscriber that keeps 1,000; those it had no
+// room for are dropped, the newest never.
 Throughput run_agnocast_throughput(std::size_t size, std::size_t count);
 
 // One message a millisecond from one publisher to `subscribers`, both sides
@@ -112,11 +131,17 @@ class BackgroundTraffic {
 class IdleEndpoints {
  public:
   IdleEndpoints(std::size_t processes, std::size_t topics);
+  // `publishers` idle publishers of the one topic `topic`, in as few
+  // processes as the endpoint limit per process allows.
+  static IdleEndpoints publishers_of(const std::string& topic, std::size_t publishers);
   ~IdleEndpoints();
   IdleEndpoints(const IdleEndpoints&) = delete;
   IdleEndpoints& operator=(const IdleEndpoints&) = delete;
 
  private:
+  // Publisher t (of `publishers`) on topic_of(t).
+  IdleEndpoints(std::size_t processes, std::size_t publishers,
+                const std::function<std::string(std::size_t)>& topic_of);
   void release_all() noexcept;
 
   int release_fd_ = -1;  // closing it lets every process go

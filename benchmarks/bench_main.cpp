@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <agnocast/limits.hpp>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -29,6 +30,7 @@
 #include "baselines.hpp"
 #include "bench_support.hpp"
 #include "iceoryx_runner.hpp"
+#include "kernel_memory.hpp"
 #include "readme_plots.hpp"
 #include "recording.hpp"
 #include "report_shape.hpp"
@@ -51,6 +53,20 @@ struct Plan {
   // instructions, which the ordinary mode's noise hides.
   std::vector<std::size_t> idle_topics{1, 100, 1000, 10000};
   std::vector<std::size_t> attached_processes{2, 50, 200};
+  // QoS depths of both sides: the one-way latency, and the publisher's
+  // publish() call into a subscriber that takes every message or never does
+  // (its queue full, so each publish drops the oldest). The last is the
+  // limit, qos_depth_max.
+  std::vector<std::size_t> depths{1, 10, 100, agnocast::qos_depth_max};
+  // The publish() call into full depth-1 queues of this many polling
+  // subscribers: one, and the limit of a topic.
+  std::vector<std::size_t> full_queue_subscribers{1, agnocast::subscribers_per_topic_max};
+  // The one-way latency beside this many other publishers of the topic:
+  // none, and the limit of a topic less the measured one.
+  std::vector<std::size_t> other_publishers{0, agnocast::publishers_per_topic_max - 1};
+  // Objects of each kind whose kernel memory is measured (a process may hold
+  // 1,024 endpoints by default, and four kinds are made).
+  std::size_t memory_objects = 250;
   // Request and response payloads of the service's round trip.
   std::vector<std::size_t> service_sizes{64, 4 << 20};
   std::size_t rounds = 20;
@@ -58,7 +74,11 @@ struct Plan {
   std::size_t constant_bytes_samples = 2;  // each writes 64 MiB first
   std::size_t fanout_samples = 5;
   std::size_t steady_messages = 1000;  // at 1 kHz
+  // Messages back to back: 64 B ones, and 4 MiB ones (each written whole);
+  // repeated for an interval in the ordinary mode.
   std::size_t throughput_count = 20000;
+  std::size_t large_throughput_count = 200;
+  std::size_t throughput_repeats = 7;
   std::size_t background_topics = 63;
   std::uint64_t seed = 1;
   bool smoke = false;
@@ -86,8 +106,14 @@ struct Plan {
     service_sizes = {64};
     idle_topics = {100};
     attached_processes = {4};
+    depths = {10};
+    full_queue_subscribers = {2};
+    other_publishers = {3};
+    memory_objects = 20;
     steady_messages = 30;
     throughput_count = 200;
+    large_throughput_count = 10;
+    throughput_repeats = 2;
   }
 };
 
@@ -326,6 +352,54 @@ json cost_breakdown(const std::string& program, bool smoke, const std::string& w
   }
 }
 
+// Messages back to back, agnocast and iceoryx in turn, `plan.throughput_repeats`
+// times: per system and size the median rate (its 95 % interval over the
+// repeats when there are several), and agnocast's rate over iceoryx's,
+// paired by repeat (higher is better).  In icount mode a second is 10^9
+// instructions.
+json throughput_json(const Plan& plan, bench::IceoryxRunner* iceoryx) {
+  json throughput;
+  throughput["repeats"] = plan.throughput_repeats;
+  const std::vector<std::pair<std::size_t, std::size_t>> runs{
+      {64, plan.throughput_count}, {std::size_t{4} << 20, plan.large_throughput_count}};
+  auto summary = [&](const std::vector<double>& values) {
+    const bench::RoundEstimate estimate = bench::estimate_over_rounds(values);
+    json value = {{"value", estimate.value}};
+    value["interval"] = values.size() > 1 ? json{estimate.low, estimate.high} : json();
+    return value;
+  };
+  for (const auto& [size, count] : runs) {
+    const std::string label = bench::format_size(size);
+    std::vector<double> agnocast_rates, iceoryx_rates, ratios;
+    std::uint64_t received = 0, iceoryx_received = 0;
+    for (std::size_t repeat = 0; repeat < plan.throughput_repeats; ++repeat) {
+      const bench::Throughput agnocast = bench::run_agnocast_throughput(size, count);
+      agnocast_rates.push_back(agnocast.messages_per_s);
+      received += agnocast.received;
+      if (!iceoryx) continue;
+      const bench::Throughput other = iceoryx->throughput(size, count);
+      iceoryx_rates.push_back(other.messages_per_s);
+      iceoryx_received += other.received;
+      ratios.push_back(agnocast.messages_per_s / other.messages_per_s);
+    }
+    const double published = static_cast<double>(count * plan.throughput_repeats);
+    json agnocast_json = summary(agnocast_rates);
+    agnocast_json["published"] = count;
+    agnocast_json["received_fraction"] = static_cast<double>(received) / published;
+    throughput["agnocast"][label] = agnocast_json;
+    if (iceoryx) {
+      json iceoryx_json = summary(iceoryx_rates);
+      iceoryx_json["published"] = count;
+      iceoryx_json["received_fraction"] = static_cast<double>(iceoryx_received) / published;
+      throughput["iceoryx"][label] = iceoryx_json;
+      throughput["vs_iceoryx"][label] = summary(ratios);
+    } else {
+      throughput["iceoryx"][label] = nullptr;
+    }
+  }
+  return throughput;
+}
+
 json cpu_json(const bench::CpuPerMessage& cpu) {
   return {{"publisher", cpu.publisher_us}, {"subscriber", cpu.subscriber_us}};
 }
@@ -429,9 +503,10 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
     for (std::size_t size : plan.sizes) {
       const std::size_t scratch = bench::constant_written_bytes - size;
       const std::string label = bench::format_size(size);
-      cells.push_back({"agnocast_constant_bytes", label, [=](auto&) {
-                         return bench::run_agnocast_latency(size, m, 1, scratch).front();
-                       }});
+      cells.push_back(
+          {"agnocast_constant_bytes", label, [=](auto&) {
+             return bench::run_agnocast_latency(size, m, 1, {.scratch_bytes = scratch}).front();
+           }});
       if (iceoryx) {
         cells.push_back({"iceoryx_constant_bytes", label,
                          [&, size, scratch](auto&) { return iceoryx->measure(size, m, scratch); }});
@@ -466,6 +541,39 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                            return bench::run_agnocast_latency(64, n, 1).front();
                          }});
       }
+    }
+    if (plan.icount || plan.smoke) {
+      for (std::size_t depth : plan.depths) {
+        const std::string label = std::to_string(depth);
+        cells.push_back({"agnocast_depth", label, [=](auto&) {
+                           return bench::run_agnocast_latency(64, n, 1, {.depth = depth}).front();
+                         }});
+        cells.push_back({"agnocast_publish_taken", label, [=](auto&) {
+                           return bench::run_agnocast_publish_call(depth, 1, n, false);
+                         }});
+        cells.push_back({"agnocast_publish_into_full_queue", label, [=](auto&) {
+                           return bench::run_agnocast_publish_call(depth, 1, n, true);
+                         }});
+      }
+      for (std::size_t subscribers : plan.full_queue_subscribers) {
+        cells.push_back(
+            {"agnocast_publish_into_full_queues", std::to_string(subscribers),
+             [=](auto&) { return bench::run_agnocast_publish_call(1, subscribers, n, true); }});
+      }
+      for (std::size_t publishers : plan.other_publishers) {
+        cells.push_back(
+            {"agnocast_beside_other_publishers", std::to_string(publishers), [=](auto&) {
+               const std::string topic = "/bench/other_publishers_" + std::to_string(getpid());
+               const auto idle = bench::IdleEndpoints::publishers_of(topic, publishers);
+               return bench::run_agnocast_latency(64, n, 1, {.topic = topic}).front();
+             }});
+      }
+      // The longest topic name the library takes.
+      cells.push_back({"agnocast_longest_topic_name", small, [=](auto&) {
+                         const std::string topic =
+                             "/" + std::string(agnocast::topic_name_max - 1, 'n');
+                         return bench::run_agnocast_latency(64, n, 1, {.topic = topic}).front();
+                       }});
     }
     for (std::size_t subscribers : plan.fanouts) {
       const std::string label = std::to_string(subscribers);
@@ -520,7 +628,15 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
   const std::string smallest_label = bench::format_size(plan.sizes.front());
   const std::string largest_label = bench::format_size(plan.sizes.back());
   std::vector<std::string> size_labels, fanout_labels, service_labels, topics_labels,
-      processes_labels;
+      processes_labels, depth_labels, full_queues_labels, publishers_labels;
+  auto labels_of = [](const std::vector<std::size_t>& counts) {
+    std::vector<std::string> labels;
+    for (std::size_t count : counts) labels.push_back(std::to_string(count));
+    return labels;
+  };
+  depth_labels = labels_of(plan.depths);
+  full_queues_labels = labels_of(plan.full_queue_subscribers);
+  publishers_labels = labels_of(plan.other_publishers);
   for (std::size_t size : plan.sizes) size_labels.push_back(bench::format_size(size));
   for (std::size_t topics : plan.idle_topics) topics_labels.push_back(std::to_string(topics));
   for (std::size_t processes : plan.attached_processes) {
@@ -545,6 +661,12 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       {"unix_socket_request_response", {"1 B"}},
       {"agnocast_beside_idle_topics", topics_labels},
       {"agnocast_with_processes_attached", processes_labels},
+      {"agnocast_depth", depth_labels},
+      {"agnocast_publish_taken", depth_labels},
+      {"agnocast_publish_into_full_queue", depth_labels},
+      {"agnocast_publish_into_full_queues", full_queues_labels},
+      {"agnocast_beside_other_publishers", publishers_labels},
+      {"agnocast_longest_topic_name", {small}},
   };
   for (const auto& [who, labels] : series) {
     for (const auto& label : labels) {
@@ -657,6 +779,27 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
                 p50(r, "agnocast_with_processes_attached",
                     std::to_string(plan.attached_processes.front()));
        }},
+      {"depth_flatness", not_in_mode, 1.02,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_depth", std::to_string(plan.depths.back())) /
+                p50(r, "agnocast_depth", std::to_string(plan.depths.front()));
+       }},
+      {"full_queue_depth_flatness", not_in_mode, 1.02,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_publish_into_full_queue", std::to_string(plan.depths.back())) /
+                p50(r, "agnocast_publish_into_full_queue", std::to_string(plan.depths.front()));
+       }},
+      {"other_publishers_flatness", not_in_mode, 1.02,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_beside_other_publishers",
+                    std::to_string(plan.other_publishers.back())) /
+                p50(r, "agnocast_beside_other_publishers",
+                    std::to_string(plan.other_publishers.front()));
+       }},
+      {"longest_topic_name", not_in_mode, 1.02,
+       [&](std::size_t r) {
+         return p50(r, "agnocast_longest_topic_name", small) / p50(r, "agnocast", small);
+       }},
       {"service_size_flatness", 1.02, 1.02,
        [&](std::size_t r) {
          // A smoke run measures the smallest size only.
@@ -745,6 +888,16 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
     std::cerr << "the cost of one round trip of a service, call by call...\n";
     report["cost_breakdown_service"] = cost_breakdown(breakdown_program, plan.smoke, " --service");
   }
+  if ((plan.icount || plan.smoke) && plan.selected("kernel_memory")) {
+    std::cerr << "kernel memory per object...\n";
+    try {
+      report["kernel_memory"] = bench::measure_kernel_memory(plan.memory_objects);
+    } catch (const std::exception& error) {
+      // The rest of the report stands; the smoke's shape check fails on it.
+      std::cerr << "agnocast-bench: kernel memory: " << error.what() << "\n";
+      report["kernel_memory"] = {{"error", error.what()}};
+    }
+  }
   if (!plan.series.empty()) return report;  // a selection: its series only
 
   std::cerr << "system calls and CPU time at 1 kHz...\n";
@@ -766,11 +919,7 @@ json run(const Plan& plan, const std::string& iceoryx_role, const std::string& b
       {"mqueue_epoll_floor", cpu_json(bench::run_mqueue_floor_cpu(plan.steady_messages))}};
 
   std::cerr << "throughput...\n";
-  auto throughput = bench::run_agnocast_throughput(64, plan.throughput_count);
-  report["throughput"] = {{"size_bytes", 64},
-                          {"published", throughput.published},
-                          {"received", throughput.received},
-                          {"messages_per_s", throughput.messages_per_s}};
+  report["throughput"] = throughput_json(plan, iceoryx ? &*iceoryx : nullptr);
 
   // Recording is CPU time and drops at a real rate: wall-time work, so only
   // in the ordinary mode.
@@ -863,9 +1012,10 @@ int window_check(const Plan& plan, const std::string& iceoryx_role, bool counter
     std::vector<Cell> cells;
     for (std::size_t written : {std::size_t{0}, scratch}) {
       const std::string label = written ? "64 MiB written" : "nothing written";
-      cells.push_back({"agnocast", label, [=](auto&) {
-                         return bench::run_agnocast_latency(64, m, 1, written).front();
-                       }});
+      cells.push_back(
+          {"agnocast", label, [=](auto&) {
+             return bench::run_agnocast_latency(64, m, 1, {.scratch_bytes = written}).front();
+           }});
       if (iceoryx) {
         cells.push_back(
             {"iceoryx", label, [&, written](auto&) { return iceoryx->measure(64, m, written); }});
@@ -1041,6 +1191,7 @@ int main(int argc, char** argv) {
   if (windows) return window_check(plan, iceoryx_role, window_counters);
   if (smoke) plan.make_smoke();
   if (plan.icount && !smoke && rounds->count() == 0) plan.rounds = 3;
+  if (plan.icount && !smoke) plan.throughput_repeats = 1;  // deterministic
   if (plan.icount && !smoke) plan.fanouts = plan.icount_fanouts;
   try {
     json report = run(plan, iceoryx_role, breakdown_program, cli, python);

@@ -181,4 +181,14 @@ std::string format_size(std::size_t bytes) {
   return std::to_string(bytes) + " B";
 }
 
+Throughput throughput_of(std::int64_t first_sent_ns, std::int64_t last_received_ns,
+                         std::uint64_t received, std::uint64_t published) {
+  Throughput result;
+  result.published = published;
+  result.received = received;
+  const double seconds = static_cast<double>(last_received_ns - first_sent_ns) / 1e9;
+  result.messages_per_s = seconds > 0 ? static_cast<double>(received) / seconds : 0;
+  return result;
+}
+
 }  // namespace agnocast::bench

@@ -82,6 +82,16 @@ bool read_all(int fd, void* data, std::size_t size);
 void send_latencies(int fd, const std::vector<std::int64_t>& latencies_ns);
 std::vector<std::int64_t> receive_latencies(int fd);
 
+// Messages sent back to back: how many the receiver got, over the time from
+// the first one's send to the last one's arrival.
+struct Throughput {
+  double messages_per_s = 0;
+  std::uint64_t received = 0;
+  std::uint64_t published = 0;
+};
+Throughput throughput_of(std::int64_t first_sent_ns, std::int64_t last_received_ns,
+                         std::uint64_t received, std::uint64_t published);
+
 // Parses "64", "4K", "1M" (binary units).
 std::size_t parse_size(const std::string& text);
 std::string format_size(std::size_t bytes);

@@ -3,6 +3,8 @@
 // the subscriber, asleep in a WaitSet (no busy polling), stops it on taking
 // the chunk.  Run by agnocast-bench with RouDi already up.  With --steady,
 // one message a millisecond and no acks: each side reports its CPU time.
+// With --throughput, messages back to back and no acks: the subscriber
+// reports how many it received between the first one's send and the last.
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstring>
@@ -45,6 +47,7 @@ struct Options {
   std::size_t count = 100;
   std::size_t scratch_bytes = 0;
   bool steady = false;
+  bool throughput = false;
   std::string instance = "0";
   int ready_fd = -1, ack_fd = -1, results_fd = -1;
 };
@@ -54,12 +57,35 @@ void report_cpu(int results_fd, std::int64_t side, std::int64_t cpu_ns) {
   bench::write_all(results_fd, report, sizeof report);
 }
 
+// Back to back, as agnocast's throughput publisher: each chunk's payload
+// written (zeros, as agnocast's vector resize writes them), its header
+// stamped. A loan refused (every chunk still queued or held) is retried.
+int publish_back_to_back(iox::popo::UntypedPublisher& publisher, const Options& options) {
+  for (std::size_t seq = 0; seq < options.count; ++seq) {
+    auto loan =
+        publisher.loan(static_cast<std::uint32_t>(sizeof(Header) + options.size), alignof(Header));
+    while (loan.has_error()) {
+      std::this_thread::yield();
+      loan = publisher.loan(static_cast<std::uint32_t>(sizeof(Header) + options.size),
+                            alignof(Header));
+    }
+    auto* chunk = static_cast<std::uint8_t*>(loan.value());
+    std::memset(chunk + sizeof(Header), 0, options.size);
+    auto* header = reinterpret_cast<Header*>(chunk);
+    header->seq = seq;
+    header->t0_ns = bench::now_ns();
+    publisher.publish(chunk);
+  }
+  return 0;
+}
+
 int run_publisher(const Options& options) {
   iox::runtime::PoshRuntime::initRuntime(runtime_name("pub", options.instance));
   iox::popo::UntypedPublisher publisher(service_of(options.instance));
   char byte = 0;
   if (!bench::read_all(options.ready_fd, &byte, 1)) return 1;
   while (!publisher.hasSubscribers()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  if (options.throughput) return publish_back_to_back(publisher, options);
   bench::SharedScratch scratch(options.scratch_bytes);
   bench::SampleWindows windows("iceoryx size=" + std::to_string(options.size) +
                                " scratch=" + std::to_string(options.scratch_bytes));
@@ -98,10 +124,38 @@ int run_publisher(const Options& options) {
   return 0;
 }
 
+// Takes until the last message (the newest is never discarded), then
+// reports {first one's send time, last one's arrival, messages received}.
+int receive_back_to_back(iox::popo::UntypedSubscriber& subscriber, iox::popo::WaitSet<>& waitset,
+                         const Options& options) {
+  std::int64_t first_t0 = 0, last_t1 = 0, received = 0;
+  bool done = false;
+  while (!done) {
+    waitset.wait();
+    while (!done) {
+      auto taken = subscriber.take();
+      if (taken.has_error()) break;
+      Header header;
+      std::memcpy(&header, taken.value(), sizeof header);
+      if (received++ == 0) first_t0 = header.t0_ns;
+      subscriber.release(taken.value());
+      if (header.seq + 1 == options.count) {
+        last_t1 = bench::now_ns();
+        done = true;
+      }
+    }
+  }
+  const std::int64_t report[3] = {first_t0, last_t1, received};
+  bench::write_all(options.results_fd, report, sizeof report);
+  return 0;
+}
+
 int run_subscriber(const Options& options) {
   iox::runtime::PoshRuntime::initRuntime(runtime_name("sub", options.instance));
   iox::popo::SubscriberOptions subscriber_options;
-  subscriber_options.queueCapacity = 16;
+  // Back to back, as deep a queue as iceoryx allows (agnocast's subscriber
+  // keeps 1,000).
+  subscriber_options.queueCapacity = options.throughput ? 256 : 16;
   iox::popo::UntypedSubscriber subscriber(service_of(options.instance), subscriber_options);
   iox::popo::WaitSet<> waitset;
   if (waitset.attachState(subscriber, iox::popo::SubscriberState::HAS_DATA).has_error()) return 1;
@@ -110,6 +164,7 @@ int run_subscriber(const Options& options) {
 
   const std::size_t total =
       options.steady ? bench::steady_warmup_messages + options.count : options.count;
+  if (options.throughput) return receive_back_to_back(subscriber, waitset, options);
   std::vector<std::int64_t> latencies;
   latencies.reserve(total);
   // In a fixed-rate run the subscription may complete after the first
@@ -170,6 +225,7 @@ int main(int argc, char** argv) {
   app.add_option("--scratch", options.scratch_bytes, "bytes written elsewhere before each message");
   app.add_option("--instance", options.instance, "service instance and runtime name suffix");
   app.add_flag("--steady", options.steady, "one message a millisecond; report CPU time");
+  app.add_flag("--throughput", options.throughput, "back to back; report messages received");
   app.add_option("--ready-fd", options.ready_fd)->required();
   app.add_option("--ack-fd", options.ack_fd)->required();
   app.add_option("--results-fd", options.results_fd);

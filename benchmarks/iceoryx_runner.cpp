@@ -63,7 +63,7 @@ version = 1
 
 [[segment.mempool]]
 size = 1024
-count = 64
+count = 512
 
 [[segment.mempool]]
 size = 8192
@@ -72,6 +72,10 @@ count = 32
 [[segment.mempool]]
 size = 1049600
 count = 4
+
+[[segment.mempool]]
+size = 4198400
+count = 16
 
 [[segment.mempool]]
 size = 16778240
@@ -142,6 +146,33 @@ std::vector<std::int64_t> IceoryxRunner::measure(std::size_t size, std::size_t c
   }
   latencies.erase(latencies.begin(), latencies.begin() + warmup);
   return latencies;
+}
+
+Throughput IceoryxRunner::throughput(std::size_t size, std::size_t count) {
+  Pipe ready = Pipe::open(), ack = Pipe::open(), results = Pipe::open();
+  auto fd = [](int value) { return std::to_string(value); };
+  const std::string size_text = std::to_string(size), count_text = std::to_string(count);
+  const std::string instance = std::to_string(getpid()) + "_" + std::to_string(++pairs_);
+  pid_t subscriber =
+      exec_child({role_program_, "sub", "--instance", instance, "--throughput", "--size", size_text,
+                  "--count", count_text, "--ready-fd", fd(ready.write_fd), "--ack-fd",
+                  fd(ack.write_fd), "--results-fd", fd(results.write_fd)},
+                 false);
+  pid_t publisher = exec_child(
+      {role_program_, "pub", "--instance", instance, "--throughput", "--size", size_text, "--count",
+       count_text, "--ready-fd", fd(ready.read_fd), "--ack-fd", fd(ack.read_fd)},
+      false);
+  for (Pipe* pipe : {&ready, &ack}) {
+    pipe->close_read();
+    pipe->close_write();
+  }
+  results.close_write();
+  std::int64_t numbers[3] = {};
+  const bool reported = read_all(results.read_fd, numbers, sizeof numbers);
+  results.close_read();
+  bool ok = wait_ok(publisher) & wait_ok(subscriber);
+  if (!ok || !reported) throw std::runtime_error("iceoryx throughput roles failed");
+  return throughput_of(numbers[0], numbers[1], static_cast<std::uint64_t>(numbers[2]), count);
 }
 
 CpuPerMessage IceoryxRunner::cpu_per_message(std::size_t count) {

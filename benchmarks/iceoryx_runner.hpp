@@ -25,6 +25,10 @@ class IceoryxRunner {
   // publisher writing `scratch_bytes` of shared memory before each.
   std::vector<std::int64_t> measure(std::size_t size, std::size_t count, std::size_t scratch_bytes);
 
+  // `count` messages of `size` bytes back to back to one subscriber, as
+  // run_agnocast_throughput.
+  Throughput throughput(std::size_t size, std::size_t count);
+
   // CPU time of each side per 64 B message, one message a millisecond.
   CpuPerMessage cpu_per_message(std::size_t count);
 

@@ -227,6 +227,115 @@ void print_plot(const PlotLinks& plots, const char* table) {
   if (link != plots.end()) std::printf("\n%s\n", link->second.c_str());
 }
 
+// Each limit of <agnocast/limits.hpp> on the message path, reached, beside
+// the same measurement far from it; icount mode only.
+void print_limits(const json& report, const char* unit) {
+  const json& latency = report["latency"];
+  for (const char* who : {"agnocast_depth", "agnocast_publish_into_full_queues",
+                          "agnocast_beside_other_publishers", "agnocast_longest_topic_name"}) {
+    if (!latency.contains(who) || !latency[who].is_object() || latency[who].empty()) return;
+  }
+  auto first_label = [&](const char* who) { return latency[who].begin().key(); };
+  auto last_label = [&](const char* who) {
+    std::string last;
+    for (const auto& [label, stats] : latency[who].items()) last = label;
+    return last;
+  };
+  std::printf(
+      "\n| limit reached, %s (p50 / p99) | measured | at the limit | far from it |\n"
+      "|---|---|---|---|\n",
+      unit);
+  const std::string depth_max = last_label("agnocast_depth");
+  const std::string depth_min = first_label("agnocast_depth");
+  std::printf(
+      "| `qos_depth_max` = %s | `publish()` into a full queue | %s | %s (depth %s) |\n",
+      depth_max.c_str(), cell(latency, "agnocast_publish_into_full_queue", depth_max).c_str(),
+      cell(latency, "agnocast_publish_into_full_queue", depth_min).c_str(), depth_min.c_str());
+  const std::string most = last_label("agnocast_publish_into_full_queues");
+  const std::string fewest = first_label("agnocast_publish_into_full_queues");
+  std::printf(
+      "| `subscribers_per_topic_max` = %s | `publish()` into that many full depth-1 queues of "
+      "polling subscribers | %s | %s (%s) |\n",
+      most.c_str(), cell(latency, "agnocast_publish_into_full_queues", most).c_str(),
+      cell(latency, "agnocast_publish_into_full_queues", fewest).c_str(), fewest.c_str());
+  const std::string others = last_label("agnocast_beside_other_publishers");
+  std::printf(
+      "| `publishers_per_topic_max` = %d | one-way 64 B beside %s other publishers of the topic "
+      "| %s | %s (none) |\n",
+      std::stoi(others) + 1, others.c_str(),
+      cell(latency, "agnocast_beside_other_publishers", others).c_str(),
+      cell(latency, "agnocast_beside_other_publishers",
+           first_label("agnocast_beside_other_publishers"))
+          .c_str());
+  std::printf(
+      "| `topic_name_max` = 245 | one-way 64 B on a topic name that long | %s | %s "
+      "(`agnocast`, 64 B) |\n",
+      cell(latency, "agnocast_longest_topic_name", "64 B").c_str(),
+      cell(latency, "agnocast", "64 B").c_str());
+  if (latency.contains("agnocast_beside_idle_topics")) {
+    const std::string topics = last_label("agnocast_beside_idle_topics");
+    const std::string fewest_topics = first_label("agnocast_beside_idle_topics");
+    std::printf(
+        "| the module's `max_topics_per_namespace` (4,096 by default; 16,384 here) | one-way 64 "
+        "B beside %s idle topics | %s | %s (%s) |\n",
+        topics.c_str(), cell(latency, "agnocast_beside_idle_topics", topics).c_str(),
+        cell(latency, "agnocast_beside_idle_topics", fewest_topics).c_str(), fewest_topics.c_str());
+  }
+}
+
+// Kernel memory per object the module keeps, from the memory cgroup's
+// counters; icount mode (and the smoke run).
+void print_kernel_memory(const json& report) {
+  const json& memory = at_path(report, {"kernel_memory", "bytes_per_object"});
+  if (!memory.is_object()) return;
+  std::printf(
+      "\n| kernel memory per object, bytes (%s of each, made in a memory cgroup of their own) | "
+      "`slab` of memory.stat | `kernel` of memory.stat |\n|---|---|---|\n",
+      number(report["kernel_memory"]["objects"], "%.0f").c_str());
+  const std::pair<const char*, const char*> kinds[] = {
+      {"topic_with_publisher", "a topic with its first publisher"},
+      {"publisher", "another publisher of a topic"},
+      {"polling_subscriber", "a polling subscriber, depth 1"},
+      {"callback_subscriber", "a callback subscriber, depth 10, with its notification queue"},
+      {"held_entry", "an entry a publisher's depth window keeps"}};
+  for (const auto& [kind, what] : kinds) {
+    std::printf("| %s | %s | %s |\n", what, number(at_path(memory, {kind, "slab"}), "%.0f").c_str(),
+                number(at_path(memory, {kind, "kernel"}), "%.0f").c_str());
+  }
+}
+
+// Messages back to back, agnocast against iceoryx.
+void print_throughput(const json& report) {
+  const json& throughput = report["throughput"];
+  if (!throughput.contains("agnocast")) return;  // reports from before it had sizes
+  const bool icount = report.value("mode", "ordinary") == "icount";
+  auto rate = [](const json& run) {
+    if (!run.is_object()) return std::string("—");
+    std::string text = number(run["value"], "%.0f");
+    if (run["interval"].is_array()) {
+      text += " (" + number(run["interval"][0], "%.0f") + "–" + number(run["interval"][1], "%.0f") +
+              ")";
+    }
+    return text + ", " + number(json(run["received_fraction"].get<double>() * 100), "%.0f") +
+           " % received";
+  };
+  std::printf(
+      "\n| back to back, one publisher → one subscriber, messages per %s (median%s) | agnocast | "
+      "iceoryx | agnocast / iceoryx |\n|---|---|---|---|\n",
+      icount ? "10^9 instructions" : "second", icount ? "" : " and 95 % interval");
+  for (const auto& [label, run] : throughput["agnocast"].items()) {
+    const json& ratio = at_path(throughput, {"vs_iceoryx", label.c_str()});
+    std::string ratio_text = ratio.is_object() ? number(ratio["value"], "%.2f") : "—";
+    if (ratio.is_object() && ratio["interval"].is_array()) {
+      ratio_text += " (" + number(ratio["interval"][0], "%.2f") + "–" +
+                    number(ratio["interval"][1], "%.2f") + ")";
+    }
+    std::printf("| %s, %s sent | %s | %s | %s |\n", label.c_str(),
+                number(run["published"], "%.0f").c_str(), rate(run).c_str(),
+                rate(at_path(throughput, {"iceoryx", label.c_str()})).c_str(), ratio_text.c_str());
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> report_shape_errors(const json& report) {
@@ -273,9 +382,25 @@ std::vector<std::string> report_shape_errors(const json& report) {
   if (smoke) {
     check.latency("agnocast_beside_idle_topics", "100");
     check.latency("agnocast_with_processes_attached", "4");
+    for (const char* who :
+         {"agnocast_depth", "agnocast_publish_taken", "agnocast_publish_into_full_queue"}) {
+      check.latency(who, "10");
+    }
+    check.latency("agnocast_publish_into_full_queues", "2");
+    check.latency("agnocast_beside_other_publishers", "3");
+    check.latency("agnocast_longest_topic_name", "64 B");
   } else if (icount) {
-    check.ratio("idle_topics_flatness", true);
-    check.ratio("attached_processes_flatness", true);
+    for (const char* name :
+         {"idle_topics_flatness", "attached_processes_flatness", "depth_flatness",
+          "full_queue_depth_flatness", "other_publishers_flatness", "longest_topic_name"}) {
+      check.ratio(name, true);
+    }
+  }
+  if (smoke || icount) {
+    for (const char* kind : {"topic_with_publisher", "publisher", "polling_subscriber",
+                             "callback_subscriber", "held_entry"}) {
+      check.positive({"kernel_memory", "bytes_per_object", kind, "slab"});
+    }
   }
   check.latency("unix_socket_request_response", "1 B");
   check.ratio("service_vs_one_way", icount);
@@ -316,7 +441,13 @@ std::vector<std::string> report_shape_errors(const json& report) {
     check.positive({"cpu_us_per_message", who, "publisher"});
     check.positive({"cpu_us_per_message", who, "subscriber"});
   }
-  check.positive({"throughput", "messages_per_s"});
+  for (const char* size : {"64 B", "4 MiB"}) {
+    for (const char* who : {"agnocast", "iceoryx"}) {
+      check.positive({"throughput", who, size, "value"});
+      check.positive({"throughput", who, size, "received_fraction"});
+    }
+    check.positive({"throughput", "vs_iceoryx", size, "value"});
+  }
   if (!icount) {
     // Recording: the recorder's CPU per message, every file complete.
     for (const char* run : {"pointcloud2_4mib_20hz", "small_64b_1khz"}) {
@@ -469,7 +600,24 @@ void print_markdown(const json& report, const PlotLinks& plots) {
     }
     print_plot(plots, plot);
   }
+
+  // QoS depth, and publish() into full queues; icount mode only.
+  if (latency.contains("agnocast_depth")) {
+    std::printf(
+        "\n| QoS depth of both sides, %s (p50 / p99) | one-way 64 B | `publish()`, the subscriber "
+        "taking each message | `publish()` into its full queue (the oldest dropped) |\n"
+        "|---|---|---|---|\n",
+        unit);
+    for (const auto& [label, stats] : latency["agnocast_depth"].items()) {
+      std::printf("| %s | %s | %s | %s |\n", label.c_str(),
+                  cell(latency, "agnocast_depth", label).c_str(),
+                  cell(latency, "agnocast_publish_taken", label).c_str(),
+                  cell(latency, "agnocast_publish_into_full_queue", label).c_str());
+    }
+  }
   print_plot(plots, "depth");
+  print_limits(report, unit);
+  print_kernel_memory(report);
 
   // Reports from before services were measured have none.
   if (latency.contains("agnocast_service")) {
@@ -559,10 +707,7 @@ void print_markdown(const json& report, const PlotLinks& plots) {
                 number(background["delivered_per_s"], "%.0f").c_str(),
                 number(background["offered_per_s"], "%.0f").c_str());
   }
-  std::printf("Throughput, 64 B back to back: %s messages/s (%llu of %llu received).\n",
-              number(report["throughput"]["messages_per_s"], "%.0f").c_str(),
-              report["throughput"]["received"].get<unsigned long long>(),
-              report["throughput"]["published"].get<unsigned long long>());
+  print_throughput(report);
   if (report.contains("recording") && report["recording"].is_object()) {
     const json& recording = report["recording"];
     std::printf(

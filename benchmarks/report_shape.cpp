@@ -811,6 +811,53 @@ void print_why_latency_stands(const json& icount) {
       budget - kernel_path, fits ? "it fits" : "less than it takes now");
 }
 
+// What going further would take: the design's floor (one mqueue hop and two
+// null ioctls) against where the one-way path stands, part by part.
+void print_what_would_change(const json& icount) {
+  const json& breakdown = icount["cost_breakdown"];
+  const double publish = call_ns(breakdown, "publisher", "ioctl PUBLISH");
+  const double receive = call_ns(breakdown, "subscriber", "ioctl RECEIVE");
+  const double hop = number_or_nan(at_path(breakdown, {"reference", "mqueue_hop_epoll_ns"}));
+  const double blocking_hop = number_or_nan(at_path(breakdown, {"reference", "mqueue_hop_ns"}));
+  const double null_ioctl = number_or_nan(at_path(breakdown, {"reference", "null_ioctl_ns"}));
+  const double mq_receive = number_or_nan(at_path(breakdown, {"reference", "mq_receive_ns"}));
+  const double ours = number_or_nan(at_path(icount, {"latency", "agnocast", "64 B", "p50_us"}));
+  if (std::isnan(publish) || std::isnan(receive) || std::isnan(hop) || std::isnan(null_ioctl) ||
+      std::isnan(mq_receive) || std::isnan(blocking_hop) || std::isnan(ours)) {
+    return;
+  }
+  // agnocast's subscriber takes its notification after the callback, so the
+  // window holds the hop less its mq_receive.
+  const double window_hop = hop - mq_receive;
+  const double floor = window_hop + 2 * null_ioctl;
+  const double library = ours * 1000 - window_hop - publish - receive;
+  std::printf(
+      "\n## What would have to change to go further\n\n"
+      "The floor of this design is one mqueue hop and two ioctls that do nothing: %.0f "
+      "instructions (the hop from `mq_send` to the return from `epoll_wait`, less the "
+      "receiver's `mq_receive`, which agnocast's subscriber makes after the callback: %.0f; "
+      "and two null ioctls of %.0f each). The 64 B one way is %.0f, %.0f above it:\n\n"
+      "- PUBLISH does %.0f beyond a null ioctl: the topic's lock, an entry from the module's "
+      "slab cache, a reference for each subscriber, the list of those to wake copied out. "
+      "RECEIVE does %.0f beyond one: the subscriber's queue, the entry's publisher and pool, "
+      "the held list. That bookkeeping in the kernel is what lets it clean up after a process "
+      "that dies at any point; keeping it in shared memory instead would have subscribers "
+      "write where today they only read (a subscriber maps a publisher's pool read-only).\n"
+      "- The library's own code inside the window is %.0f (the publish call around its "
+      "ioctl and `mq_send` on one side; the executor's wake-up, its receive loop and the "
+      "callback's dispatch on the other; the cost breakdown above has each side's share).\n"
+      "- The hop itself: a receiver asleep in `mq_receive` is woken in %.0f, against %.0f "
+      "through `epoll_wait`. An executor that sleeps in `mq_receive` when it has one "
+      "subscription and nothing else would save the difference, but would not wait on timers, "
+      "other subscriptions or cancel; every executor waits in `epoll_wait` today.\n"
+      "- Merging the wake-up into PUBLISH (the module waking the subscriber itself, instead of "
+      "the publisher's `mq_send`) would save a system call entry and the mqueue's own locking. "
+      "The notification through a POSIX queue is the protocol's (its queue names and message "
+      "are normative), so that is a new protocol, not an optimisation.\n",
+      floor, window_hop, null_ioctl, ours * 1000, ours * 1000 - floor, publish - null_ioctl,
+      receive - null_ioctl, library, blocking_hop, hop);
+}
+
 // The service's two targets, each with the references it is set beside.
 void print_round_trip_standing(const json& report, const char* format, bool with_interval) {
   const json& latency = report["latency"];
@@ -993,6 +1040,40 @@ series (icount) measure the 64 B series beside 1 to 10,000 idle topics (one
 publisher each, 1,000 a process, the module loaded with
 `max_topics_per_namespace=16384`) and with 2 to 200 processes attached.
 
+The depth series (icount) give both sides a QoS depth of 1, 10, 100 and
+1,024 (`qos_depth_max`) and time the 64 B one-way latency, and the
+publisher's `publish()` call (wall time, a clock read either side) into one
+polling subscriber of its own process that takes each message before the next
+or never does: then its queue stays full, and every publish drops the oldest
+entry, which the publisher reclaims. After each run the kernel's counters
+(what `agnocast-cli topic info` shows) must agree: the queue as full as its
+depth and every message beyond it dropped, or nothing left and nothing
+dropped. The limits table reaches each limit of `<agnocast/limits.hpp>` a
+message's path could feel, beside the same measurement far from it: a full
+queue at the deepest depth, 1,024 full depth-1 queues of polling subscribers
+(in two processes), 1,023 other publishers of the measured topic, and a topic
+name of 245 characters. The other limits (node and type names, a schema's
+size and nesting, an access policy's rules and principals) are checked once,
+when an endpoint is made or a policy loaded, and no message meets them: they
+are not timed. **Kernel memory** is read, not estimated: a process in a
+memory cgroup of its own makes 250 objects of each kind, and memory.stat's
+`slab` (the slab objects allocated for them, in bytes) and `kernel` (every
+kernel page charged, so it scatters around `slab` by up to a page over the
+250) are read after each kind, once the kernel's periodic flush of its per-CPU
+counters has run. The module allocates everything with `GFP_KERNEL_ACCOUNT`;
+a callback subscriber's figure includes its notification queue. A held entry
+is one a publisher's window of depth 1,024 keeps.
+
+**Throughput** sends messages back to back from one publisher to one
+subscriber, each payload written (zeros), and counts what the subscriber
+received between the first one's publish and the last one's arrival:
+agnocast's subscriber keeps 1,000 (what it has no room for is dropped, the
+newest never), iceoryx's queue holds 256, its maximum (its publisher waits
+for a chunk when every one is queued or held: it has 512 of 1 KiB and 16 of
+4 MiB). In icount mode a second is 10^9 instructions, so the rate is messages
+per 10^9 instructions; the ordinary mode repeats each pair 7 times, for the
+median and its interval.
+
 A service's round trip is timed from `async_send_request()`, the request
 already written, to the first line of the client's response callback, one
 request in flight, both sides asleep (the client paused, the server in
@@ -1127,6 +1208,15 @@ depend on it.
       "(`attached_processes_flatness`): %s\n",
       standing(at_path(icount, {"ratios", "idle_topics_flatness"}), 1.02, "%.3f").c_str(),
       standing(at_path(icount, {"ratios", "attached_processes_flatness"}), 1.02, "%.3f").c_str());
+  std::printf(
+      "- nothing on the message path grows with the QoS depth, 1 to 1,024: one way "
+      "(`depth_flatness`): %s; `publish()` into a full queue (`full_queue_depth_flatness`): %s; "
+      "nor with 1,023 other publishers of the topic (`other_publishers_flatness`): %s, nor with "
+      "a topic name of 245 characters (`longest_topic_name`): %s\n",
+      standing(at_path(icount, {"ratios", "depth_flatness"}), 1.02, "%.3f").c_str(),
+      standing(at_path(icount, {"ratios", "full_queue_depth_flatness"}), 1.02, "%.3f").c_str(),
+      standing(at_path(icount, {"ratios", "other_publishers_flatness"}), 1.02, "%.3f").c_str(),
+      standing(at_path(icount, {"ratios", "longest_topic_name"}), 1.02, "%.3f").c_str());
   print_round_trip_standing(icount, "%.3f", false);
   print_why_latency_stands(icount);
   print_why_round_trip_stands(icount);
@@ -1216,6 +1306,7 @@ release's deadline (at most 4 ms after the wake-up that left it) is the
 timeout of the executor's wait, so no timer is set, read or woken for while
 messages keep coming.
 )");
+  print_what_would_change(icount);
 }
 
 }  // namespace agnocast::bench

@@ -958,28 +958,42 @@ int repeat_check(std::size_t samples, double tolerance) {
 // attached, each pair within `tolerance`. In icount mode the p50s are
 // instruction counts, so this checks the scale series' slope, not a timing.
 int scale_check(std::size_t samples, double tolerance) {
-  auto p50_beside = [&](std::size_t processes, std::size_t topics) {
-    const Cell cell{"agnocast", "64 B", [=](auto&) {
-                      const bench::IdleEndpoints idle(processes, topics);
-                      return bench::run_agnocast_latency(64, samples, 1).front();
-                    }};
+  auto p50_of = [&](const std::function<std::vector<std::int64_t>()>& measure) {
+    const Cell cell{"agnocast", "64 B", [&](auto&) { return measure(); }};
     std::vector<std::int64_t> measured, extra;
     if (!run_isolated(cell, 300, measured, extra)) return std::numeric_limits<double>::quiet_NaN();
     return bench::summarize(measured).p50_us * 1000;
+  };
+  auto p50_beside = [&](std::size_t processes, std::size_t topics) {
+    return p50_of([=] {
+      const bench::IdleEndpoints idle(processes, topics);
+      return bench::run_agnocast_latency(64, samples, 1).front();
+    });
+  };
+  auto p50_at_depth = [&](std::size_t depth) {
+    return p50_of(
+        [=] { return bench::run_agnocast_latency(64, samples, 1, {.depth = depth}).front(); });
+  };
+  auto full_queue_publish_at_depth = [&](std::size_t depth) {
+    return p50_of([=] { return bench::run_agnocast_publish_call(depth, 1, samples, true); });
   };
   struct Pair {
     const char* what;
     double small, large;
   };
   const Pair pairs[] = {
-      {"1 -> 1,000 idle topics", p50_beside(1, 1), p50_beside(1, 1000)},
-      {"2 -> 50 processes attached", p50_beside(0, 0), p50_beside(48, 48)},
+      {"one way 64 B, 1 -> 1,000 idle topics", p50_beside(1, 1), p50_beside(1, 1000)},
+      {"one way 64 B, 2 -> 50 processes attached", p50_beside(0, 0), p50_beside(48, 48)},
+      {"one way 64 B, QoS depth 1 -> 1,024", p50_at_depth(1),
+       p50_at_depth(agnocast::qos_depth_max)},
+      {"publish() into a full queue, depth 1 -> 1,024", full_queue_publish_at_depth(1),
+       full_queue_publish_at_depth(agnocast::qos_depth_max)},
   };
   int status = 0;
   for (const Pair& pair : pairs) {
     const double growth = pair.large / pair.small - 1;
     const bool flat = std::isfinite(growth) && std::abs(growth) <= tolerance;
-    std::printf("agnocast 64 B p50, %s: %.0f ns, then %.0f ns: %+.3f %% (at most %.1f %%): %s\n",
+    std::printf("agnocast p50, %s: %.0f ns, then %.0f ns: %+.3f %% (at most %.1f %%): %s\n",
                 pair.what, pair.small, pair.large, growth * 100, tolerance * 100,
                 flat ? "flat" : "NOT FLAT");
     if (!flat) status = 1;
@@ -1128,8 +1142,9 @@ int main(int argc, char** argv) {
                "of icount mode's repeatability)");
   bool scale = false;
   app.add_flag("--scale-check", scale,
-               "measure agnocast's 64 B p50 beside 1 and 1,000 idle topics, and with 2 and 50 "
-               "processes attached; fail if a pair differs by more than 2 % (in icount mode: "
+               "measure agnocast's 64 B p50 beside 1 and 1,000 idle topics, with 2 and 50 "
+               "processes attached, at QoS depth 1 and 1,024, and publish() into a full queue "
+               "at depth 1 and 1,024; fail if a pair differs by more than 2 % (in icount mode: "
                "nothing on the message path grows with them)");
   bool windows = false, window_counters = false;
   app.add_flag("--window-counters", window_counters,

@@ -40,7 +40,7 @@ _agnocast_cli() {
         return
       fi
       ;;
-    "topic ") candidates="list info hz echo" ;;
+    "topic ") candidates="list info hz delay echo" ;;
     "service ") candidates="list info type call" ;;
     "service call")
       # NAME, then its TYPE as the service says it; the JSON is the user's.
@@ -59,10 +59,10 @@ _agnocast_cli() {
     "process ") candidates="list" ;;
     "daemon ") candidates="status" ;;
     "policy ") candidates="show" ;;
-    "topic info" | "topic hz" | "topic echo")
+    "topic info" | "topic hz" | "topic delay" | "topic echo")
       if [[ $cur == -* || ${#words[@]} -ge 3 ]]; then
         case ${words[1]} in
-          hz) candidates="--window --count --json --help" ;;
+          hz | delay) candidates="--window --count --json --help" ;;
           echo) candidates="--count --timeout --no-arrays --definition --json --help" ;;
           *) candidates="--json --help" ;;
         esac

@@ -98,15 +98,14 @@ TEST(Cli, AnUnknownCommandIsNamedWithTheValidOnes) {
       << r.err;
   r = run(source, {"--json", "topic", "lsit"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(
-      r.err.find(
-          "unknown command 'lsit' for 'agnocast-cli topic'; valid commands: list, info, hz, echo"),
-      std::string::npos)
+  EXPECT_NE(r.err.find("unknown command 'lsit' for 'agnocast-cli topic'; valid commands: list, "
+                       "info, hz, delay, echo"),
+            std::string::npos)
       << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["exit_code"], 2);
   r = run(source, {"topic"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("'agnocast-cli topic' needs a command: list, info, hz, echo"),
+  EXPECT_NE(r.err.find("'agnocast-cli topic' needs a command: list, info, hz, delay, echo"),
             std::string::npos)
       << r.err;
 }

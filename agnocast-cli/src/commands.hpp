@@ -27,6 +27,20 @@ TopicInfo require_topic(InspectionSource& source, const std::string& topic);
 std::string topic_list_table(const nlohmann::json& value);
 std::string topic_info_table(const nlohmann::json& value);
 
+// topic delay TOPIC: per window, each subscriber's delay from publish() to
+// its callback's start: min_us, p50_us, p99_us, max_us (null when it timed
+// none), messages and missed (null for a subscriber that records none).
+struct DelayOptions {
+  std::string topic;
+  double window_s = 1.0;
+  std::optional<std::size_t> count;
+  bool json = false;  // JSON Lines instead of a header and rows per window
+};
+void set_topic_delay_command(CLI::App& topic, Context& context);
+int topic_delay(InspectionSource& source, const DelayOptions& options, std::ostream& out);
+std::string topic_delay_header();
+std::string topic_delay_lines(const nlohmann::json& window);
+
 // topic hz TOPIC: one measurement per window: rate_hz, the period's
 // min_s, max_s and std_dev_s (null with fewer than two messages so far) and
 // bytes_per_s of payload, until --count windows or a signal.

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "agnocast/errors.hpp"
@@ -58,6 +59,8 @@ class FakeSource : public InspectionSource {
   std::function<void(FakeSource&)> on_sleep;
   std::map<std::string, FakeStream> streams;  // by topic; none: the topic has no schema
   bool stop = false;                          // SIGINT or SIGTERM arrived
+  // What each subscriber's process recorded, by (pid, topic, subscriber id).
+  std::map<std::tuple<pid_t, std::string, std::uint32_t>, RecordedDelays> delays;
 
   std::optional<Version> module_version() override {
     return loaded ? std::optional(version) : std::nullopt;
@@ -123,6 +126,11 @@ class FakeSource : public InspectionSource {
     const auto stream = streams.find(topic);
     if (stream == streams.end()) throw TopicWithoutSchema(topic + " has no schema");
     return parse_schema(stream->second.schema);
+  }
+  std::optional<RecordedDelays> recorded_delays(pid_t pid, const std::string& topic,
+                                                std::uint32_t subscriber_id) override {
+    const auto it = delays.find({pid, topic, subscriber_id});
+    return it == delays.end() ? std::nullopt : std::optional(it->second);
   }
   bool stop_requested() override { return stop; }
   double now_seconds() override { return clock; }

@@ -80,6 +80,10 @@ class InspectionSource {
   // The schema `topic`'s endpoints registered, without subscribing; throws
   // like subscribe().
   virtual Schema topic_schema(const std::string& topic) = 0;
+  // The publish → callback-start delays a process recorded for one of its
+  // subscribers; nullopt when it keeps none for it.
+  virtual std::optional<RecordedDelays> recorded_delays(pid_t pid, const std::string& topic,
+                                                        std::uint32_t subscriber_id) = 0;
   // True once SIGINT or SIGTERM asked a streaming command to stop.
   virtual bool stop_requested() = 0;
 

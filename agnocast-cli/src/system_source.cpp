@@ -130,6 +130,10 @@ class SystemSource final : public InspectionSource {
   Schema topic_schema(const std::string& topic) override {
     return resolve_schema_topic(topic).schema;
   }
+  std::optional<RecordedDelays> recorded_delays(pid_t pid, const std::string& topic,
+                                                std::uint32_t subscriber_id) override {
+    return agnocast::recorded_delays(pid, topic, subscriber_id);
+  }
   bool stop_requested() override { return !agnocast::ok(); }
 
   bool path_exists(const std::string& path) override { return ::access(path.c_str(), F_OK) == 0; }

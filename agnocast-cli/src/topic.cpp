@@ -1,4 +1,5 @@
-// agnocast-cli topic list | info TOPIC (hz: topic_hz.cpp, echo: echo.cpp)
+// agnocast-cli topic list | info TOPIC (hz: topic_hz.cpp, delay: topic_delay.cpp, echo:
+// echo.cpp)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -167,6 +168,7 @@ void set_topic_command(CLI::App& app, Context& context) {
       {[&context, name] { return topic_info_json(context.source, *name); }, topic_info_table});
 
   set_topic_hz_command(*topic, context);
+  set_topic_delay_command(*topic, context);
   set_topic_echo_command(*topic, context);
 }
 

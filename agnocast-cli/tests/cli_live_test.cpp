@@ -279,6 +279,46 @@ TEST_F(CliLive, TopicHzMeasuresRateJitterAndPayloadWithoutSubscribing) {
   EXPECT_EQ(lines_of(table.out).size(), 2u) << table.out;
 }
 
+TEST_F(CliLive, TopicDelayShowsEachCallbackSubscribersDelayFromPublish) {
+  const Outcome r = cli("topic delay " + topic + " --window 2 --count 1 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(lines_of(r.out).size(), 1u) << r.out;
+  const json window = json::parse(r.out);
+  EXPECT_EQ(window["name"], topic);
+  EXPECT_GE(window["window_s"].get<double>(), 2.0);
+  ASSERT_EQ(window["subscribers"].size(), 2u) << r.out;
+  const json live = find_by(window["subscribers"], "pid", listener);
+  ASSERT_FALSE(live.is_null()) << r.out;
+  EXPECT_EQ(live["node"], "listener");
+  // The talker publishes at 50 Hz; the listener's callback takes each one.
+  EXPECT_GT(live["messages"].get<int>(), 20) << r.out;
+  EXPECT_EQ(live["missed"], 0);
+  const double min = live["min_us"], p50 = live["p50_us"], p99 = live["p99_us"],
+               max = live["max_us"];
+  EXPECT_GT(min, 0.0);
+  EXPECT_LE(min, p50);
+  EXPECT_LE(p50, p99);
+  EXPECT_LE(p99, max);
+  EXPECT_LT(p50, 1e6) << "a delay of a second under emulation is no delay but a fault";
+  // The stopped listener's callbacks do not run: none timed.
+  const json frozen = find_by(window["subscribers"], "pid", stopped);
+  ASSERT_FALSE(frozen.is_null()) << r.out;
+  EXPECT_EQ(frozen["messages"], 0);
+  EXPECT_TRUE(frozen["p50_us"].is_null());
+
+  const Outcome table = cli("topic delay " + topic + " --window 1 --count 1");
+  ASSERT_EQ(table.code, 0) << table.err;
+  EXPECT_EQ(row_starting(table.out, "SUBSCRIBER"),
+            (std::vector<std::string>{"SUBSCRIBER", "NODE", "MIN_US", "P50_US", "P99_US", "MAX_US",
+                                      "MESSAGES"}));
+  EXPECT_EQ(lines_of(table.out).size(), 3u) << table.out;
+  const Outcome missing = cli("topic delay /nope --count 1");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("no publisher or subscriber uses topic '/nope'"), std::string::npos)
+      << missing.err;
+  EXPECT_EQ(cli("topic delay " + topic + " --window 0").code, 2);
+}
+
 TEST_F(CliLive, NodeInfoAndProcessListShowTheTalker) {
   const json node = cli("node info talker --json").value();
   EXPECT_EQ(node["pids"], json::array({talker}));

@@ -42,6 +42,9 @@ void clean_dead_process(const DeadProcess& process, Host& host, Counters& counte
       spdlog::info("removed queue {} of dead process {}", queue, process.pid);
     }
   }
+  if (host.remove_stale_delay_record(process.pid)) {
+    spdlog::info("removed the delay record of dead process {}", process.pid);
+  }
   ++counters.processes_cleaned;
   spdlog::info("cleaned up after dead process {} ({} queue(s))", process.pid,
                process.queues.size());

@@ -43,6 +43,19 @@ TEST(CleanDeadProcess, RemovesItsQueuesThenCounts) {
   EXPECT_EQ(counters.processes_cleaned, 1u);
 }
 
+TEST(CleanDeadProcess, RemovesItsDelayRecordOnlyWhenNoLiveProcessMadeIt) {
+  FakeHost host;
+  host.delay_records = {77, 78};
+  Counters counters;
+  clean_dead_process({77, {}}, host, counters);
+  EXPECT_EQ(host.delay_records, std::set<pid_t>{78});
+  // Pid 78 died, but a new process of that pid made the record now there.
+  host.live_pids = {78};
+  clean_dead_process({78, {}}, host, counters);
+  EXPECT_EQ(host.delay_records, std::set<pid_t>{78});
+  EXPECT_THAT(host.delay_record_checks, ElementsAre(77, 78));
+}
+
 TEST(HandleExitRecords, CleansCompletedProcessesWithoutSweeping) {
   FakeHost host;
   host.queues = {"a@1", "stale@9"};

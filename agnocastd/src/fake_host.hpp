@@ -16,6 +16,9 @@ class FakeHost final : public Host {
   std::set<std::string> queues;  // file names in /dev/mqueue, "x@1"
   std::set<std::string> live;    // queue names, "/x@1"
   bool kernel_unreachable = false;
+  std::set<pid_t> delay_records;                // pids with a record in /dev/shm
+  std::set<pid_t> live_pids;                    // whose records are their own
+  std::vector<pid_t> delay_record_checks;       // remove_stale_delay_record's arguments
   std::vector<std::string> calls;               // the order of OS work, for order checks
   std::function<void()> between_list_and_live;  // runs after queue_files()
 
@@ -33,6 +36,13 @@ class FakeHost final : public Host {
   bool remove_queue(const std::string& name) override {
     calls.push_back("remove_queue " + name);
     return queues.erase(name.substr(1)) > 0;
+  }
+  std::vector<pid_t> delay_record_pids() override {
+    return std::vector<pid_t>(delay_records.begin(), delay_records.end());
+  }
+  bool remove_stale_delay_record(pid_t pid) override {
+    delay_record_checks.push_back(pid);
+    return !live_pids.contains(pid) && delay_records.erase(pid) > 0;
   }
 };
 

@@ -50,4 +50,10 @@ bool SystemHost::remove_queue(const std::string& name) {
   return removed(::mq_unlink(name.c_str()), "queue " + name);
 }
 
+std::vector<pid_t> SystemHost::delay_record_pids() { return agnocast::delay_record_pids(); }
+
+bool SystemHost::remove_stale_delay_record(pid_t pid) {
+  return agnocast::remove_stale_delay_record(pid);
+}
+
 }  // namespace agnocastd

@@ -2,6 +2,8 @@
 // cleaner's and the sweeper's decisions are unit-tested with a fake.
 #pragma once
 
+#include <sys/types.h>
+
 #include <set>
 #include <string>
 #include <vector>
@@ -17,6 +19,10 @@ class Host {
   virtual std::set<std::string> live_queues() = 0;
   // mq_unlink(name); false when it did not exist (or could not be removed, logged).
   virtual bool remove_queue(const std::string& name) = 0;
+  // The pids of the delay records in /dev/shm (agnocast::delay_record_pids).
+  virtual std::vector<pid_t> delay_record_pids() = 0;
+  // agnocast::remove_stale_delay_record: true when pid's record was removed.
+  virtual bool remove_stale_delay_record(pid_t pid) = 0;
 };
 
 // The Host of this machine: /dev/mqueue and the kernel module.
@@ -25,6 +31,8 @@ class SystemHost final : public Host {
   std::vector<std::string> queue_files() override;
   std::set<std::string> live_queues() override;
   bool remove_queue(const std::string& name) override;
+  std::vector<pid_t> delay_record_pids() override;
+  bool remove_stale_delay_record(pid_t pid) override;
 };
 
 }  // namespace agnocastd

@@ -34,6 +34,11 @@ void sweep(Host& host, Counters& counters) {
       spdlog::info("removed stale queue {} (no live subscriber owns it)", queue);
     }
   }
+  for (const pid_t pid : host.delay_record_pids()) {
+    if (host.remove_stale_delay_record(pid)) {
+      spdlog::info("removed the delay record of dead process {}", pid);
+    }
+  }
 }
 
 }  // namespace agnocastd

@@ -1,5 +1,5 @@
-// The sweep: removes what no exit record will ever name — queues left by
-// crashes before the daemon ran or by an earlier module load.
+// The sweep: removes what no exit record will ever name — queues and delay
+// records left by crashes before the daemon ran or by an earlier module load.
 #pragma once
 
 #include <set>
@@ -18,8 +18,8 @@ namespace agnocastd {
 std::vector<std::string> stale_queues(const std::vector<std::string>& listed_files,
                                       const std::set<std::string>& live_queues);
 
-// Removes stale queues. Removes none when the kernel cannot be asked which
-// are live.
+// Removes stale queues, and the delay records of processes gone. Removes
+// no queue when the kernel cannot be asked which are live.
 void sweep(Host& host, Counters& counters);
 
 }  // namespace agnocastd

@@ -31,6 +31,16 @@ TEST(Sweep, RemovesStaleQueuesAndKeepsLiveOnes) {
   EXPECT_EQ(counters.queues_removed, 1u);
 }
 
+TEST(Sweep, RemovesTheDelayRecordsOfProcessesGone) {
+  FakeHost host;
+  host.delay_records = {10, 11, 12};
+  host.live_pids = {11};
+  Counters counters;
+  sweep(host, counters);
+  EXPECT_EQ(host.delay_records, std::set<pid_t>{11});
+  EXPECT_EQ(counters.queues_removed, 0u);  // records are not queues
+}
+
 TEST(Sweep, ListsQueuesBeforeAskingTheKernel) {
   FakeHost host;
   host.queues = {"chatter@1"};

@@ -99,4 +99,21 @@ std::optional<std::vector<std::uint8_t>> topic_schema(const std::string& topic);
 // queue_owners() of every topic the module lists now.
 std::map<std::string, QueueOwner> live_queue_owners();
 
+// The delays, from publish() to the start of the callback, that a process
+// recorded for one of its callback subscribers (agnocast-cli topic delay).
+struct RecordedDelays {
+  std::uint64_t count = 0;              // recorded since the subscriber began
+  std::vector<std::int64_t> newest_ns;  // the newest of them (at most 1,024), oldest first
+};
+// nullopt when the process keeps none for that subscriber: a polling one, a
+// process gone or of another start, or a record that is missing or malformed.
+// Reads a file of the process's, not the module.
+std::optional<RecordedDelays> recorded_delays(pid_t pid, const std::string& topic,
+                                              std::uint32_t subscriber_id);
+// The pids whose processes made such a record (a file each in /dev/shm).
+std::vector<pid_t> delay_record_pids();
+// Removes the record of `pid` when no live process made it: its maker died
+// (and the pid may be another process's now). True when it was removed.
+bool remove_stale_delay_record(pid_t pid);
+
 }  // namespace agnocast

@@ -16,6 +16,7 @@
 #include "agnocast/detail/endpoints.hpp"
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
+#include "delay/delay_file.hpp"
 #include "endpoints/endpoint_request.hpp"
 #include "endpoints/node_state.hpp"
 #include "endpoints/notification_queue.hpp"
@@ -324,6 +325,7 @@ struct SubscriptionBase::State {
   std::unique_ptr<OwnedQueue> queue;
   std::shared_ptr<ReleaseTimer> release_timer;
   std::mutex receive_mutex;
+  std::unique_ptr<DelayRecorder> delays;  // written under receive_mutex
 };
 
 SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_view topic,
@@ -336,6 +338,10 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
+  // A service's carriers are not topics anyone asks the delay of.
+  state_->delays = use == TopicUse::application
+                       ? std::make_unique<DelayRecorder>(state_->topic, state_->endpoint->id().id)
+                       : std::make_unique<DelayRecorder>();
   // If the queue cannot be created, the endpoint's destructor removes the subscriber.
   state_->queue = std::make_unique<OwnedQueue>(
       agnocast::queue_name(topic, state_->endpoint->id().id), qos.depth());
@@ -422,8 +428,9 @@ std::size_t SubscriptionBase::handle_wakeup() {
       grants.unlock();
       while (handed_out < result.entry_count) {
         const std::size_t i = handed_out++;
-        deliver(reinterpret_cast<const void*>(entries[i].addr), references[i],
-                info_of(runtime, entries[i]));
+        const MessageInfo info = info_of(runtime, entries[i]);
+        state.delays->record(info.publish_time);
+        deliver(reinterpret_cast<const void*>(entries[i].addr), references[i], info);
         ++delivered;
       }
     } catch (...) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "agnocast/executor.hpp"
+#include "agnocast/inspect.hpp"
 #include "agnocast/node.hpp"
 #include "kernel/fake_runtime.hpp"
 
@@ -71,6 +72,33 @@ TEST_F(SubscriptionTest, OneWakeUpDeliversEveryWaitingMessageOldestFirst) {
   constexpr int batch = static_cast<int>(Kernel::receive_entries_max);
   EXPECT_EQ(kernel().calls().receive, (70 + batch - 1) / batch);
   EXPECT_EQ(subscription->handle_wakeup(), 0U);
+}
+
+TEST_F(SubscriptionTest, EachCallbackRecordsItsDelayFromPublishForTopicDelay) {
+  Node node{"delayed"};
+  const std::string name = topic("delayed");
+  int calls = 0;
+  auto subscription = node.create_subscription<Counted>(
+      name, QoS{10}, [&](const ipc_shared_ptr<const Counted>&) { ++calls; });
+  auto polling = node.create_polling_subscriber<Counted>(name, QoS{10});
+  auto publisher = node.create_publisher<Counted>(name, QoS{10});
+  const auto published = std::chrono::steady_clock::now();
+  for (std::uint64_t seq = 0; seq < 5; ++seq) publish(*publisher, seq);
+  EXPECT_EQ(subscription->handle_wakeup(), 5U);
+  const auto longest = std::chrono::steady_clock::now() - published;
+  const auto delays = recorded_delays(::getpid(), name, subscription->id());
+  ASSERT_TRUE(delays);
+  EXPECT_EQ(delays->count, 5U);
+  ASSERT_EQ(delays->newest_ns.size(), 5U);
+  for (const std::int64_t delay : delays->newest_ns) {
+    EXPECT_GE(delay, 0);
+    EXPECT_LE(delay, std::chrono::duration_cast<std::chrono::nanoseconds>(longest).count());
+  }
+  // A polling subscriber has no callback, so no delay.
+  EXPECT_FALSE(recorded_delays(::getpid(), name, polling->id()));
+  const std::uint32_t id = subscription->id();
+  subscription.reset();
+  EXPECT_FALSE(recorded_delays(::getpid(), name, id));
 }
 
 TEST_F(SubscriptionTest, AWakeUpTakesOneNotificationAndReceivesOnceAtAnyDepth) {

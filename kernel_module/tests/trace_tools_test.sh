@@ -9,7 +9,7 @@ tracing=/sys/kernel/tracing
 events="publish receive release reclaim shed drop process_exit"
 
 perf list 'agnocast:*' >perf-list.txt 2>&1
-trace-cmd list -e 'agnocast:*' >trace-cmd-list.txt 2>&1
+trace-cmd list -e '^agnocast:' >trace-cmd-list.txt 2>&1
 for event in $events; do
   grep -q "agnocast:$event .*Tracepoint event" perf-list.txt ||
     { cat perf-list.txt; echo "perf list lacks agnocast:$event"; exit 1; }
@@ -48,8 +48,8 @@ timeout 120 trace-cmd record -q -e agnocast:publish -e agnocast:receive -o trace
 grep -qx "$received" trace-cmd.json || { cat trace-cmd.json; echo "the listener missed messages"; exit 1; }
 trace-cmd report -i trace.dat >report.txt 2>/dev/null
 for event in publish receive; do
-  grep " $event: topic=$topic " report.txt | grep -o 'entry_id=[0-9]*' | sort -u >ids.txt
-  lines=$(grep -c " $event: topic=$topic " report.txt || true)
+  grep -E " $event: +topic=$topic " report.txt | grep -o 'entry_id=[0-9]*' | sort -u >ids.txt
+  lines=$(grep -cE " $event: +topic=$topic " report.txt || true)
   ids=$(wc -l <ids.txt)
   if [ "$lines" != 20 ] || [ "$ids" != 20 ] || ! grep -qx 'entry_id=0' ids.txt ||
      ! grep -qx 'entry_id=19' ids.txt; then

@@ -12,7 +12,6 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <mutex>
 #include <sstream>
 
@@ -155,16 +154,25 @@ struct ReadOnlyMapping {
 std::string delay_file_path(pid_t pid) { return delay_file_prefix + std::to_string(pid); }
 
 std::optional<std::uint64_t> process_start_time(pid_t pid) {
-  std::ifstream file("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  // Plain reads: a stream's read of a process that dies meanwhile throws.
+  const int fd = ::open(("/proc/" + std::to_string(pid) + "/stat").c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  std::string text;
+  char buffer[512];
+  for (ssize_t got; (got = ::read(fd, buffer, sizeof buffer)) > 0;) {
+    text.append(buffer, static_cast<std::size_t>(got));
+  }
+  ::close(fd);
   // The command name may hold spaces and parentheses: fields follow the last ')'.
   const std::size_t close = text.rfind(')');
   if (close == std::string::npos) return std::nullopt;
   std::istringstream fields(text.substr(close + 1));
   std::string field;
   // Field 3 (state) is the first after the name; the start time is field 22.
+  // A zombie (Z) or a dead process (X) lives no more.
   for (int index = 3; index < 22; ++index) {
     if (!(fields >> field)) return std::nullopt;
+    if (index == 3 && (field == "Z" || field == "X")) return std::nullopt;
   }
   std::uint64_t start_time = 0;
   if (!(fields >> start_time)) return std::nullopt;

@@ -52,8 +52,8 @@ inline constexpr std::size_t delay_file_bytes =
 
 // The file's name for `pid`.
 std::string delay_file_path(pid_t pid);
-// A process's start time as /proc/PID/stat gives it (field 22); nullopt when
-// the process does not exist.
+// A live process's start time as /proc/PID/stat gives it (field 22); nullopt
+// when no process of that pid lives (a zombie does not).
 std::optional<std::uint64_t> process_start_time(pid_t pid);
 
 // One subscription's slot while it lives; records nothing when it has none

@@ -150,6 +150,16 @@ TEST(DelayFile, TheStartTimeOfAProcessIsItsOwnAndNoneOnceItIsGone) {
   ASSERT_TRUE(own);
   EXPECT_EQ(process_start_time(::getpid()), own);
   EXPECT_FALSE(process_start_time(dead_pid()));
+  // A zombie, not reaped yet, lives no more: its record is stale already.
+  const pid_t zombie = ::fork();
+  if (zombie == 0) ::_exit(0);
+  siginfo_t info{};
+  ASSERT_EQ(::waitid(P_PID, static_cast<id_t>(zombie), &info, WEXITED | WNOWAIT), 0);
+  EXPECT_FALSE(process_start_time(zombie));
+  std::ofstream(delay_file_path(zombie)) << "left behind";
+  EXPECT_TRUE(remove_stale_delay_record(zombie));
+  int status = 0;
+  ::waitpid(zombie, &status, 0);
 }
 
 }  // namespace

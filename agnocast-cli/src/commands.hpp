@@ -15,6 +15,7 @@
 #include "agnocast/status.hpp"
 #include "cli.hpp"
 #include "inspection_source.hpp"
+#include "topic_windows.hpp"
 
 namespace agnocast::cli {
 
@@ -30,12 +31,7 @@ std::string topic_info_table(const nlohmann::json& value);
 // topic delay TOPIC: per window, each subscriber's delay from publish() to
 // its callback's start: min_us, p50_us, p99_us, max_us (null when it timed
 // none), messages and missed (null for a subscriber that records none).
-struct DelayOptions {
-  std::string topic;
-  double window_s = 1.0;
-  std::optional<std::size_t> count;
-  bool json = false;  // JSON Lines instead of a header and rows per window
-};
+using DelayOptions = WindowOptions;
 void set_topic_delay_command(CLI::App& topic, Context& context);
 int topic_delay(InspectionSource& source, const DelayOptions& options, std::ostream& out);
 std::string topic_delay_header();
@@ -44,13 +40,7 @@ std::string topic_delay_lines(const nlohmann::json& window);
 // topic hz TOPIC: one measurement per window: rate_hz, the period's
 // min_s, max_s and std_dev_s (null with fewer than two messages so far) and
 // bytes_per_s of payload, until --count windows or a signal.
-struct HzOptions {
-  std::string topic;
-  double window_s = 1.0;
-  std::optional<std::size_t> count;
-  bool json = false;  // JSON Lines instead of a header and one line per window
-};
-// A subcommand of `topic`.
+using HzOptions = WindowOptions;
 void set_topic_hz_command(CLI::App& topic, Context& context);
 // Writes one line per window to `out`; returns the exit code, throws CliError
 // when the topic has no endpoint.

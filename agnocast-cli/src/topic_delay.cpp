@@ -12,8 +12,8 @@
 #include <map>
 #include <utility>
 
-#include "agnocast/naming.hpp"
 #include "commands.hpp"
+#include "topic_windows.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -21,8 +21,6 @@ namespace {
 using nlohmann::json;
 
 constexpr double sample_interval_s = 0.1;
-
-double rounded(double x, double scale) { return std::round(x * scale) / scale; }
 
 // The nearest-rank percentile of sorted values.
 std::int64_t percentile(const std::vector<std::int64_t>& sorted, double fraction) {
@@ -122,13 +120,6 @@ class DelayMeter {
   double sampled_at_;
 };
 
-std::string number_or_dash(const json& value, const char* format) {
-  if (value.is_null()) return "-";
-  char text[32];
-  std::snprintf(text, sizeof text, format, value.get<double>());
-  return text;
-}
-
 }  // namespace
 
 std::string topic_delay_header() {
@@ -156,36 +147,18 @@ std::string topic_delay_lines(const json& window) {
 
 int topic_delay(InspectionSource& source, const DelayOptions& options, std::ostream& out) {
   DelayMeter meter(source, options.topic);
-  if (!options.json) out << topic_delay_header() << std::flush;
-  for (std::size_t windows = 0; !options.count || windows < *options.count; ++windows) {
-    const std::optional<json> window = meter.measure(options.window_s);
-    if (!window) break;
-    out << (options.json ? window->dump() + "\n" : topic_delay_lines(*window)) << std::flush;
-  }
-  return exit_success;
+  return stream_windows(
+      options, out, topic_delay_header(), [&] { return meter.measure(options.window_s); },
+      topic_delay_lines);
 }
 
 void set_topic_delay_command(CLI::App& topic, Context& context) {
-  auto options = std::make_shared<DelayOptions>();
-  CLI::App* delay = topic.add_subcommand(
-      "delay",
+  add_window_command(
+      topic, context, "delay",
       "Delay from publish() to the start of each callback subscriber's callback: min, p50, "
       "p99 and max per window, from what the subscribers' processes record; until SIGINT or "
-      "--count windows");
-  delay->add_option("TOPIC", options->topic, "Topic name, e.g. /chatter")
-      ->required()
-      ->check(CLI::Validator([](std::string& name) { return topic_name_problem(name); }, "TOPIC",
-                             "topic name"));
-  delay->add_option("--window", options->window_s, "Seconds per window")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  delay->add_option("--count", options->count, "Stop after N windows (exit 0)")
-      ->check(CLI::PositiveNumber);
-  bind_command(*delay, context, {.stream = [&context, options](std::ostream& out) {
-    options->json = context.json;
-    return topic_delay(context.source, *options, out);
-  }});
-  delay->get_option("--json")->description("Print one JSON object per window (JSON Lines)");
+      "--count windows",
+      topic_delay);
 }
 
 }  // namespace agnocast::cli

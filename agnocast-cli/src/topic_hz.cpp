@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <map>
 
-#include "agnocast/naming.hpp"
 #include "commands.hpp"
+#include "topic_windows.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -17,10 +17,6 @@ namespace {
 using nlohmann::json;
 
 constexpr double sample_interval_s = 0.001;
-
-// Dividing by the power of ten gives the double nearest the decimal, which
-// JSON then prints as such (multiplying by 1e-6 would not).
-double rounded(double x, double scale) { return std::round(x * scale) / scale; }
 
 struct Counters {
   std::uint64_t messages = 0;
@@ -115,13 +111,6 @@ class HzMeter {
   std::optional<double> last_message_at_;
 };
 
-std::string number_or_dash(const json& value, const char* format) {
-  if (value.is_null()) return "-";
-  char text[32];
-  std::snprintf(text, sizeof text, format, value.get<double>());
-  return text;
-}
-
 }  // namespace
 
 std::string topic_hz_header() {
@@ -146,35 +135,17 @@ std::string topic_hz_line(const json& window) {
 
 int topic_hz(InspectionSource& source, const HzOptions& options, std::ostream& out) {
   HzMeter meter(source, options.topic);
-  if (!options.json) out << topic_hz_header() << std::flush;
-  for (std::size_t windows = 0; !options.count || windows < *options.count; ++windows) {
-    const std::optional<json> window = meter.measure(options.window_s);
-    if (!window) break;
-    out << (options.json ? window->dump() + "\n" : topic_hz_line(*window)) << std::flush;
-  }
-  return exit_success;
+  return stream_windows(
+      options, out, topic_hz_header(), [&] { return meter.measure(options.window_s); },
+      topic_hz_line);
 }
 
 void set_topic_hz_command(CLI::App& topic, Context& context) {
-  auto options = std::make_shared<HzOptions>();
-  CLI::App* hz = topic.add_subcommand(
-      "hz",
+  add_window_command(
+      topic, context, "hz",
       "Publish rate, period jitter and payload bandwidth of a topic, one line per window, from "
-      "kernel counters, without subscribing; until SIGINT or --count windows");
-  hz->add_option("TOPIC", options->topic, "Topic name, e.g. /chatter")
-      ->required()
-      ->check(CLI::Validator([](std::string& name) { return topic_name_problem(name); }, "TOPIC",
-                             "topic name"));
-  hz->add_option("--window", options->window_s, "Seconds per line")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  hz->add_option("--count", options->count, "Stop after N windows (exit 0)")
-      ->check(CLI::PositiveNumber);
-  bind_command(*hz, context, {.stream = [&context, options](std::ostream& out) {
-    options->json = context.json;
-    return topic_hz(context.source, *options, out);
-  }});
-  hz->get_option("--json")->description("Print one JSON object per window (JSON Lines)");
+      "kernel counters, without subscribing; until SIGINT or --count windows",
+      topic_hz);
 }
 
 }  // namespace agnocast::cli

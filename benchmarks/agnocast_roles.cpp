@@ -219,28 +219,10 @@ std::vector<std::int64_t> run_agnocast_publish_call(std::size_t depth, std::size
   }
   const std::string topic = next_topic("publish_call");
   const agnocast::QoS qos{depth};
-  constexpr std::size_t per_process = 1000;
-  const std::size_t local = std::min(subscribers, per_process);
-  // The other subscribers, in processes of their own until released.
-  Pipe ready = Pipe::open(), release = Pipe::open();
-  std::vector<pid_t> holders;
-  for (std::size_t first = local; first < subscribers; first += per_process) {
-    const std::size_t share = std::min(per_process, subscribers - first);
-    holders.push_back(spawn([&, share] {
-      ::close(release.write_fd);
-      agnocast::Node node{"bench_full_queues"};
-      std::vector<std::shared_ptr<agnocast::PollingSubscriber<BenchMessage>>> held;
-      for (std::size_t s = 0; s < share; ++s) {
-        held.push_back(node.create_polling_subscriber<BenchMessage>(topic, qos));
-      }
-      char byte = 1;
-      write_all(ready.write_fd, &byte, 1);
-      read_all(release.read_fd, &byte, 1);  // end of file: released
-      return 0;
-    }));
-  }
-  release.close_read();
-  ready.close_write();
+  // Up to 1,000 subscribers in the publisher's process, the rest in others.
+  const std::size_t local = std::min<std::size_t>(subscribers, 1000);
+  const IdleEndpoints others =
+      IdleEndpoints::polling_subscribers_of(topic, subscribers - local, depth);
   Pipe results = Pipe::open();
   pid_t publisher = spawn([&] {
     agnocast::Node node{"bench_publish_call"};
@@ -249,7 +231,6 @@ std::vector<std::int64_t> run_agnocast_publish_call(std::size_t depth, std::size
       polling.push_back(node.create_polling_subscriber<BenchMessage>(topic, qos));
     }
     auto pub = node.create_publisher<BenchMessage>(topic, qos);
-    read_bytes(ready.read_fd, holders.size());
     // Fills every queue first (and maps and warms the pool).
     const std::size_t filling = (queue_full ? depth : 0) + warmup_messages;
     std::vector<std::int64_t> calls;
@@ -287,13 +268,10 @@ std::vector<std::int64_t> run_agnocast_publish_call(std::size_t depth, std::size
     send_latencies(results.write_fd, calls);
     return 0;
   });
-  ready.close_read();
   results.close_write();
   std::vector<std::int64_t> calls = receive_latencies(results.read_fd);
   results.close_read();
-  ::close(release.write_fd);
   reap(publisher, "publisher");
-  for (pid_t holder : holders) reap(holder, "subscriber");
   if (calls.size() != count) throw std::runtime_error("the publisher missed calls");
   return calls;
 }
@@ -829,32 +807,43 @@ double BackgroundTraffic::delivered_per_s() const {
 }
 
 IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t topics)
-    : IdleEndpoints(processes, topics, [prefix = next_topic("idle")](std::size_t t) {
-        return prefix + "_" + std::to_string(t);
-      }) {}
+    : IdleEndpoints(processes, topics,
+                    [prefix = next_topic("idle")](agnocast::Node& node, std::size_t t) {
+                      return node.create_publisher<BenchMessage>(prefix + "_" + std::to_string(t),
+                                                                 agnocast::QoS{10});
+                    }) {}
 
 IdleEndpoints IdleEndpoints::publishers_of(const std::string& topic, std::size_t publishers) {
-  return IdleEndpoints((publishers + 999) / 1000, publishers, [&](std::size_t) { return topic; });
+  return IdleEndpoints(processes_for(publishers), publishers,
+                       [&](agnocast::Node& node, std::size_t) {
+                         return node.create_publisher<BenchMessage>(topic, agnocast::QoS{10});
+                       });
 }
 
-IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t publishers,
-                             const std::function<std::string(std::size_t)>& topic_of) {
+IdleEndpoints IdleEndpoints::polling_subscribers_of(const std::string& topic,
+                                                    std::size_t subscribers, std::size_t depth) {
+  return IdleEndpoints(
+      processes_for(subscribers), subscribers, [&](agnocast::Node& node, std::size_t) {
+        return node.create_polling_subscriber<BenchMessage>(topic, agnocast::QoS{depth});
+      });
+}
+
+IdleEndpoints::IdleEndpoints(std::size_t processes, std::size_t endpoints,
+                             const MakeEndpoint& make) {
   Pipe ready = Pipe::open(), release = Pipe::open();
   release_fd_ = release.write_fd;
   std::size_t created = 0;
   for (std::size_t p = 0; p < processes; ++p) {
-    // An even share of the publishers, the first processes one more.
-    const std::size_t share = publishers / processes + (p < publishers % processes ? 1 : 0);
+    // An even share of the endpoints, the first processes one more.
+    const std::size_t share = endpoints / processes + (p < endpoints % processes ? 1 : 0);
     const std::size_t first = created;
     created += share;
     processes_.push_back(spawn([&] {
       ::close(release.write_fd);  // the driver's copy alone holds the processes
       agnocast::Node node{"bench_idle_" + std::to_string(p)};
-      std::vector<std::shared_ptr<agnocast::Publisher<BenchMessage>>> idle;
+      std::vector<std::shared_ptr<void>> idle;
       idle.reserve(share);
-      for (std::size_t t = first; t < first + share; ++t) {
-        idle.push_back(node.create_publisher<BenchMessage>(topic_of(t), agnocast::QoS{10}));
-      }
+      for (std::size_t t = first; t < first + share; ++t) idle.push_back(make(node, t));
       char byte = 1;
       write_all(ready.write_fd, &byte, 1);
       read_all(release.read_fd, &byte, 1);  // end of file: released

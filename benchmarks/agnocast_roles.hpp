@@ -8,12 +8,17 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bench_support.hpp"
 #include "syscall_counter.hpp"
+
+namespace agnocast {
+class Node;
+}
 
 namespace agnocast::bench {
 
@@ -134,14 +139,20 @@ class IdleEndpoints {
   // `publishers` idle publishers of the one topic `topic`, in as few
   // processes as the endpoint limit per process allows.
   static IdleEndpoints publishers_of(const std::string& topic, std::size_t publishers);
+  // `subscribers` polling subscribers of `topic` with QoS `depth`, which
+  // never take: likewise.
+  static IdleEndpoints polling_subscribers_of(const std::string& topic, std::size_t subscribers,
+                                              std::size_t depth);
   ~IdleEndpoints();
   IdleEndpoints(const IdleEndpoints&) = delete;
   IdleEndpoints& operator=(const IdleEndpoints&) = delete;
 
  private:
-  // Publisher t (of `publishers`) on topic_of(t).
-  IdleEndpoints(std::size_t processes, std::size_t publishers,
-                const std::function<std::string(std::size_t)>& topic_of);
+  // Endpoint t (of `endpoints`), made by a node of its process.
+  using MakeEndpoint = std::function<std::shared_ptr<void>(agnocast::Node& node, std::size_t t)>;
+  IdleEndpoints(std::size_t processes, std::size_t endpoints, const MakeEndpoint& make);
+  // The module's default endpoints per process is 1,024: 1,000 a process.
+  static std::size_t processes_for(std::size_t endpoints) { return (endpoints + 999) / 1000; }
   void release_all() noexcept;
 
   int release_fd_ = -1;  // closing it lets every process go

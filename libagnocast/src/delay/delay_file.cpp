@@ -67,11 +67,10 @@ class DelayFile {
     return nullptr;
   }
 
-  // Frees a slot this process claimed; a fork child's call leaves its
-  // parent's file alone.
+  // Frees a slot this process claimed.
   static void release(DelaySlot* slot) {
     std::lock_guard lock(mutex_);
-    if (owner_ != ::getpid() || !base_) return;
+    if (!base_) return;
     std::atomic_ref(slot->state).store(DelaySlot::free, std::memory_order_release);
     if (--users_ > 0) return;
     ::unlink(delay_file_path(owner_).c_str());
@@ -180,10 +179,10 @@ std::optional<std::uint64_t> process_start_time(pid_t pid) {
 }
 
 DelayRecorder::DelayRecorder(std::string_view topic, std::uint32_t subscriber_id)
-    : slot_(DelayFile::claim(topic, subscriber_id)) {}
+    : slot_(DelayFile::claim(topic, subscriber_id)), claimed_by_(::getpid()) {}
 
 DelayRecorder::~DelayRecorder() {
-  if (slot_) DelayFile::release(slot_);
+  if (slot_ && claimed_by_ == ::getpid()) DelayFile::release(slot_);
 }
 
 void DelayRecorder::record_now(std::int64_t publish_time_ns) noexcept {

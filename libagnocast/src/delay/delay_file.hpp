@@ -77,6 +77,7 @@ class DelayRecorder {
  private:
   void record_now(std::int64_t publish_time_ns) noexcept;
   DelaySlot* slot_ = nullptr;
+  pid_t claimed_by_ = 0;  // a fork child's copy frees nothing of its parent's
 };
 
 }  // namespace agnocast::detail

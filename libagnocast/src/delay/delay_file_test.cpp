@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,25 @@ TEST(DelayFile, TheFileLastsAsLongAsItsRecorders) {
   // The next recorder makes it again.
   DelayRecorder again("/delay/lasting", 3);
   EXPECT_TRUE(recorded_delays(::getpid(), "/delay/lasting", 3));
+}
+
+TEST(DelayFile, AForkChildsCopyOfARecorderFreesNothingOfItsParents) {
+  auto recorder = std::make_unique<DelayRecorder>("/delay/forked", 1);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    recorder.reset();  // the parent's slot: left alone
+    bool own_file = false;
+    {
+      DelayRecorder own("/delay/child", 2);
+      own_file = own.recording() && ::access(delay_file_path(::getpid()).c_str(), F_OK) == 0;
+    }
+    const bool removed = ::access(delay_file_path(::getpid()).c_str(), F_OK) != 0;
+    ::_exit(own_file && removed ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_TRUE(recorded_delays(::getpid(), "/delay/forked", 1));
 }
 
 TEST(DelayFile, EverySlotTakenLeavesTheNextRecorderWithout) {

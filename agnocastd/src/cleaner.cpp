@@ -42,7 +42,7 @@ void clean_dead_process(const DeadProcess& process, Host& host, Counters& counte
       spdlog::info("removed queue {} of dead process {}", queue, process.pid);
     }
   }
-  if (host.remove_stale_delay_record(process.pid)) {
+  if (host.remove_stale_delay_record(process.pid, true)) {
     spdlog::info("removed the delay record of dead process {}", process.pid);
   }
   ++counters.processes_cleaned;

@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host.hpp"
@@ -16,9 +17,10 @@ class FakeHost final : public Host {
   std::set<std::string> queues;  // file names in /dev/mqueue, "x@1"
   std::set<std::string> live;    // queue names, "/x@1"
   bool kernel_unreachable = false;
-  std::set<pid_t> delay_records;                // pids with a record in /dev/shm
-  std::set<pid_t> live_pids;                    // whose records are their own
-  std::vector<pid_t> delay_record_checks;       // remove_stale_delay_record's arguments
+  std::set<pid_t> delay_records;  // pids with a record in /dev/shm
+  std::set<pid_t> live_pids;      // whose records are their own
+  // remove_stale_delay_record's arguments: pid, exit_reported.
+  std::vector<std::pair<pid_t, bool>> delay_record_checks;
   std::vector<std::string> calls;               // the order of OS work, for order checks
   std::function<void()> between_list_and_live;  // runs after queue_files()
 
@@ -40,8 +42,8 @@ class FakeHost final : public Host {
   std::vector<pid_t> delay_record_pids() override {
     return std::vector<pid_t>(delay_records.begin(), delay_records.end());
   }
-  bool remove_stale_delay_record(pid_t pid) override {
-    delay_record_checks.push_back(pid);
+  bool remove_stale_delay_record(pid_t pid, bool exit_reported) override {
+    delay_record_checks.push_back({pid, exit_reported});
     return !live_pids.contains(pid) && delay_records.erase(pid) > 0;
   }
 };

@@ -52,8 +52,8 @@ bool SystemHost::remove_queue(const std::string& name) {
 
 std::vector<pid_t> SystemHost::delay_record_pids() { return agnocast::delay_record_pids(); }
 
-bool SystemHost::remove_stale_delay_record(pid_t pid) {
-  return agnocast::remove_stale_delay_record(pid);
+bool SystemHost::remove_stale_delay_record(pid_t pid, bool exit_reported) {
+  return agnocast::remove_stale_delay_record(pid, exit_reported);
 }
 
 }  // namespace agnocastd

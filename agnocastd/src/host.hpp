@@ -22,7 +22,7 @@ class Host {
   // The pids of the delay records in /dev/shm (agnocast::delay_record_pids).
   virtual std::vector<pid_t> delay_record_pids() = 0;
   // agnocast::remove_stale_delay_record: true when pid's record was removed.
-  virtual bool remove_stale_delay_record(pid_t pid) = 0;
+  virtual bool remove_stale_delay_record(pid_t pid, bool exit_reported) = 0;
 };
 
 // The Host of this machine: /dev/mqueue and the kernel module.
@@ -32,7 +32,7 @@ class SystemHost final : public Host {
   std::set<std::string> live_queues() override;
   bool remove_queue(const std::string& name) override;
   std::vector<pid_t> delay_record_pids() override;
-  bool remove_stale_delay_record(pid_t pid) override;
+  bool remove_stale_delay_record(pid_t pid, bool exit_reported) override;
 };
 
 }  // namespace agnocastd

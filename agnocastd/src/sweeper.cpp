@@ -35,7 +35,7 @@ void sweep(Host& host, Counters& counters) {
     }
   }
   for (const pid_t pid : host.delay_record_pids()) {
-    if (host.remove_stale_delay_record(pid)) {
+    if (host.remove_stale_delay_record(pid, false)) {
       spdlog::info("removed the delay record of dead process {}", pid);
     }
   }

@@ -39,6 +39,9 @@ TEST(Sweep, RemovesTheDelayRecordsOfProcessesGone) {
   sweep(host, counters);
   EXPECT_EQ(host.delay_records, std::set<pid_t>{11});
   EXPECT_EQ(counters.queues_removed, 0u);  // records are not queues
+  // No exit record names them: a process on its way out still lives.
+  for (const auto& [pid, exit_reported] : host.delay_record_checks) EXPECT_FALSE(exit_reported);
+  EXPECT_EQ(host.delay_record_checks.size(), 3u);
 }
 
 TEST(Sweep, ListsQueuesBeforeAskingTheKernel) {

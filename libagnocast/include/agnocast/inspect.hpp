@@ -113,7 +113,9 @@ std::optional<RecordedDelays> recorded_delays(pid_t pid, const std::string& topi
 // The pids whose processes made such a record (a file each in /dev/shm).
 std::vector<pid_t> delay_record_pids();
 // Removes the record of `pid` when no live process made it: its maker died
-// (and the pid may be another process's now). True when it was removed.
-bool remove_stale_delay_record(pid_t pid);
+// (and the pid may be another process's now). With `exit_reported` (the
+// module's exit record named the pid), a process of the pid still on its way
+// out counts as gone. True when it was removed.
+bool remove_stale_delay_record(pid_t pid, bool exit_reported = false);
 
 }  // namespace agnocast

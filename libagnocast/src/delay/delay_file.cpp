@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -152,7 +153,23 @@ struct ReadOnlyMapping {
 
 std::string delay_file_path(pid_t pid) { return delay_file_prefix + std::to_string(pid); }
 
-std::optional<std::uint64_t> process_start_time(pid_t pid) {
+namespace {
+
+// What /proc/PID/stat says of a process; nullopt when there is none.
+struct ProcessStat {
+  std::string state;         // field 3: "R", "S", ..., "Z" (zombie), "X" (dead)
+  std::uint64_t flags = 0;   // field 9: the kernel's PF_* flags
+  std::uint64_t start_time;  // field 22
+};
+
+std::optional<std::uint64_t> parse_unsigned(const std::string& text) {
+  std::uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc{} || end != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+std::optional<ProcessStat> read_process_stat(pid_t pid) {
   // Plain reads: a stream's read of a process that dies meanwhile throws.
   const int fd = ::open(("/proc/" + std::to_string(pid) + "/stat").c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return std::nullopt;
@@ -166,16 +183,28 @@ std::optional<std::uint64_t> process_start_time(pid_t pid) {
   const std::size_t close = text.rfind(')');
   if (close == std::string::npos) return std::nullopt;
   std::istringstream fields(text.substr(close + 1));
+  ProcessStat stat{};
   std::string field;
-  // Field 3 (state) is the first after the name; the start time is field 22.
-  // A zombie (Z) or a dead process (X) lives no more.
-  for (int index = 3; index < 22; ++index) {
+  for (int index = 3; index <= 22; ++index) {
     if (!(fields >> field)) return std::nullopt;
-    if (index == 3 && (field == "Z" || field == "X")) return std::nullopt;
+    if (index == 3) stat.state = field;
+    if (index == 9 || index == 22) {
+      const std::optional<std::uint64_t> number = parse_unsigned(field);
+      if (!number) return std::nullopt;
+      (index == 9 ? stat.flags : stat.start_time) = *number;
+    }
   }
-  std::uint64_t start_time = 0;
-  if (!(fields >> start_time)) return std::nullopt;
-  return start_time;
+  return stat;
+}
+
+bool lives(const ProcessStat& stat) { return stat.state != "Z" && stat.state != "X"; }
+
+}  // namespace
+
+std::optional<std::uint64_t> process_start_time(pid_t pid) {
+  const std::optional<ProcessStat> stat = read_process_stat(pid);
+  if (!stat || !lives(*stat)) return std::nullopt;
+  return stat->start_time;
 }
 
 DelayRecorder::DelayRecorder(std::string_view topic, std::uint32_t subscriber_id)
@@ -277,18 +306,22 @@ std::vector<pid_t> delay_record_pids() {
   return pids;
 }
 
-bool remove_stale_delay_record(pid_t pid) {
+bool remove_stale_delay_record(pid_t pid, bool exit_reported) {
   const std::string path = detail::delay_file_path(pid);
   const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return false;
   DelayFileHeader header{};
   const bool whole = ::pread(fd, &header, sizeof header, 0) == sizeof header;
   ::close(fd);
-  const std::optional<std::uint64_t> start_time = detail::process_start_time(pid);
+  const std::optional<detail::ProcessStat> stat = detail::read_process_stat(pid);
+  // A process whose exit the kernel reported may still be on its way out
+  // (PF_EXITING): gone all the same. A new process of the pid is not exiting.
+  constexpr std::uint64_t exiting = 0x4;  // PF_EXITING
+  const bool gone = !stat || !detail::lives(*stat) || (exit_reported && (stat->flags & exiting));
   // A live process's file whose header is not written yet is its own.
   const bool made =
       whole && std::memcmp(header.magic, detail::delay_magic, sizeof header.magic) == 0;
-  const bool stale = !start_time || (made && header.start_time != *start_time);
+  const bool stale = gone || (made && header.start_time != stat->start_time);
   return stale && ::unlink(path.c_str()) == 0;
 }
 

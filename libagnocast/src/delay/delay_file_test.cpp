@@ -160,6 +160,9 @@ TEST(DelayFile, OnlyTheRecordsOfProcessesGoneAreStale) {
   EXPECT_NE(std::find(pids.begin(), pids.end(), ::getpid()), pids.end());
   EXPECT_NE(std::find(pids.begin(), pids.end(), gone), pids.end());
   EXPECT_FALSE(remove_stale_delay_record(::getpid()));
+  // An exit record of this pid while a process of it is not exiting: a new
+  // process's record, kept.
+  EXPECT_FALSE(remove_stale_delay_record(::getpid(), true));
   EXPECT_TRUE(remove_stale_delay_record(gone));
   EXPECT_FALSE(remove_stale_delay_record(gone));  // gone already
   EXPECT_TRUE(recorded_delays(::getpid(), "/delay/stale", 0));

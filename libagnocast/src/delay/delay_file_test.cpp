@@ -118,6 +118,28 @@ TEST(DelayFile, AForkChildsCopyOfARecorderFreesNothingOfItsParents) {
   EXPECT_TRUE(recorded_delays(::getpid(), "/delay/forked", 1));
 }
 
+TEST(DelayFile, ANameAnotherUserTookIsLeftAloneAndNothingIsRecorded) {
+  if (::geteuid() != 0) GTEST_SKIP() << "making a file of another user needs root";
+  const std::string path = delay_file_path(::getpid());
+  std::ofstream(path) << "planted";
+  ASSERT_EQ(::chown(path.c_str(), 65534, 65534), 0);
+  {
+    DelayRecorder recorder("/delay/planted", 1);
+    EXPECT_FALSE(recorder.recording());
+    recorder.record(now_ns());
+  }
+  std::ifstream planted(path);
+  EXPECT_EQ(
+      std::string((std::istreambuf_iterator<char>(planted)), std::istreambuf_iterator<char>()),
+      "planted");
+  std::remove(path.c_str());
+  // Its own user's leftover (a dead process of this pid) is replaced.
+  std::ofstream(path) << "left";
+  DelayRecorder recorder("/delay/planted", 1);
+  EXPECT_TRUE(recorder.recording());
+  EXPECT_TRUE(recorded_delays(::getpid(), "/delay/planted", 1));
+}
+
 TEST(DelayFile, EverySlotTakenLeavesTheNextRecorderWithout) {
   std::vector<std::unique_ptr<DelayRecorder>> recorders;
   for (std::uint32_t i = 0; i < delay_slots; ++i) {

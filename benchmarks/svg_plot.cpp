@@ -63,8 +63,13 @@ std::string tick_label(double value, double step) {
   const std::size_t sign = digits[0] == '-' ? 1 : 0;
   std::size_t point = digits.find('.');
   if (point == std::string::npos) point = digits.size();
-  for (std::size_t at = point; at > sign + 3; at -= 3) digits.insert(at - 3, ",");
-  return digits;
+  std::string grouped = digits.substr(0, sign);
+  for (std::size_t at = sign; at < point; ++at) {
+    if (at > sign && (point - at) % 3 == 0) grouped += ',';
+    grouped += digits[at];
+  }
+  grouped.append(digits, point, std::string::npos);
+  return grouped;
 }
 
 // 1, 2 or 5 times a power of ten, about `count` of them over `span`.
@@ -143,7 +148,10 @@ std::string text_element(double x, double y, const char* anchor, std::string_vie
                          std::string_view extra = "") {
   std::string out = "<text x=\"" + coordinate(x) + "\" y=\"" + coordinate(y) + "\" text-anchor=\"" +
                     anchor + "\"";
-  if (!extra.empty()) out += " " + std::string(extra);
+  if (!extra.empty()) {
+    out += ' ';
+    out += extra;
+  }
   return out + ">" + escaped(text) + "</text>\n";
 }
 
@@ -241,8 +249,10 @@ std::string render_svg(const LinePlot& plot) {
       svg += "<polyline fill=\"none\" stroke=\"" + color(i) + "\" stroke-width=\"2\"" + dash(i) +
              " points=\"";
       for (std::size_t p = 0; p < line.points.size(); ++p) {
-        svg += (p ? " " : "") + coordinate(x.at(line.points[p].x)) + "," +
-               coordinate(y.at(line.points[p].y));
+        if (p) svg += ' ';
+        svg += coordinate(x.at(line.points[p].x));
+        svg += ',';
+        svg += coordinate(y.at(line.points[p].y));
       }
       svg += "\"/>\n";
     }

@@ -52,7 +52,8 @@ class CannedPool {
     write(message + offset(type, "origin") + offset(point, "x"), x);
     write(message + offset(type, "origin") + offset(point, "y"), y);
     std::byte* elements = place(values.size_bytes(), alignof(float));
-    std::memcpy(elements, values.data(), values.size_bytes());
+    if (!values.empty())
+      std::memcpy(elements, values.data(), values.size_bytes());  // data() may be null
     write_vector(message + offset(type, "values"), elements, values.size_bytes());
     return message;
   }

@@ -83,7 +83,8 @@ TEST(Protocol, RefusesWhatIsMalformed) {
 }
 
 TEST(Protocol, ParsesClientMessageFrames) {
-  const ClientMessage message = parse_client_message(std::string("\x01\x02\x00\x00\x00\xAB", 6));
+  const std::string frame("\x01\x02\x00\x00\x00\xAB", 6);  // the payload points into it
+  const ClientMessage message = parse_client_message(frame);
   EXPECT_EQ(message.channel_id, 2U);
   ASSERT_EQ(message.payload.size(), 1U);
   EXPECT_EQ(message.payload[0], 0xAB);

@@ -131,8 +131,13 @@ Runtime& Runtime::install_for_testing(void* region, std::size_t size,
                                       std::unique_ptr<Kernel> kernel) {
   std::lock_guard lock(init_mutex);
   Runtime* runtime = new Runtime(std::move(kernel), ::getpid(), region, size);
-  // Any earlier test runtime is leaked on purpose: pointers into it may survive.
-  instance.store(runtime, std::memory_order_release);
+  // Earlier test runtimes are kept, never freed: pointers into them may
+  // survive. Kept reachable to the end (a list never destroyed), so
+  // LeakSanitizer, which looks after static destructors, does not count them.
+  static auto* const retired = new std::vector<Runtime*>;
+  if (Runtime* earlier = instance.exchange(runtime, std::memory_order_acq_rel)) {
+    retired->push_back(earlier);
+  }
   attach_pool_to_heap_hook(region, size);
   return *runtime;
 }

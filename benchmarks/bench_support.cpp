@@ -78,8 +78,10 @@ void fill_payload(std::span<std::uint8_t> payload, std::uint64_t seq) {
     const std::uint64_t value = pattern_word(seq, i);
     std::memcpy(payload.data() + i * sizeof value, &value, sizeof value);
   }
+  const std::size_t tail_bytes = payload.size() % sizeof(std::uint64_t);
+  if (tail_bytes == 0) return;  // an empty payload's data() may be null, even for no bytes
   const std::uint64_t tail = pattern_word(seq, words);
-  std::memcpy(payload.data() + words * sizeof tail, &tail, payload.size() % sizeof tail);
+  std::memcpy(payload.data() + words * sizeof tail, &tail, tail_bytes);
 }
 
 bool payload_intact(std::span<const std::uint8_t> payload, std::uint64_t seq) {
@@ -90,9 +92,10 @@ bool payload_intact(std::span<const std::uint8_t> payload, std::uint64_t seq) {
       return false;
     }
   }
+  const std::size_t tail_bytes = payload.size() % sizeof(std::uint64_t);
+  if (tail_bytes == 0) return true;
   const std::uint64_t tail = pattern_word(seq, words);
-  return std::memcmp(payload.data() + words * sizeof tail, &tail, payload.size() % sizeof tail) ==
-         0;
+  return std::memcmp(payload.data() + words * sizeof tail, &tail, tail_bytes) == 0;
 }
 
 LatencyStats summarize(std::vector<std::int64_t> latencies_ns) {

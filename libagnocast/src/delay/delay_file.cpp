@@ -157,9 +157,9 @@ namespace {
 
 // What /proc/PID/stat says of a process; nullopt when there is none.
 struct ProcessStat {
-  std::string state;         // field 3: "R", "S", ..., "Z" (zombie), "X" (dead)
-  std::uint64_t flags = 0;   // field 9: the kernel's PF_* flags
-  std::uint64_t start_time;  // field 22
+  std::string state;             // field 3: "R", "S", ..., "Z" (zombie), "X" (dead)
+  std::uint64_t flags = 0;       // field 9: the kernel's PF_* flags
+  std::uint64_t start_time = 0;  // field 22
 };
 
 std::optional<std::uint64_t> parse_unsigned(const std::string& text) {

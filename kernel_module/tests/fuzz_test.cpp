@@ -827,7 +827,7 @@ struct Worker {
   }
 
   void do_reclaim(bool wellformed) {
-    uint64_t addrs[AGNOCAST_RECLAIM_BATCH];
+    uint64_t addrs[AGNOCAST_RECLAIM_BATCH] = {};
     agnocast_reclaim rc{wellformed ? uptr(addrs) : some_ptr(4096),
                         wellformed ? AGNOCAST_RECLAIM_BATCH : static_cast<uint32_t>(rnd(600)), 0, 0,
                         0};

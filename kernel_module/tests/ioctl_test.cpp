@@ -1585,8 +1585,8 @@ TEST_F(Device, PublishWithABadOutputPublishesNothing) {
   ASSERT_EQ(release(dev, sub, rr.entries[0].entry_id), 0);  // now reclaimable
 
   auto attempt = [&](auto change) {
-    uint32_t wake[4];
-    uint64_t reclaim[4];
+    uint32_t wake[4] = {};
+    uint64_t reclaim[4] = {};
     agnocast_publish arg{};
     arg.topic_handle = pub.handle;
     arg.publisher_id = pub.id;

@@ -60,13 +60,15 @@ if(NOT KDIR)
 endif()
 
 # agnocast_add_kernel_module(TARGET name SOURCE_DIR dir MODULE_NAME name
-#                            [KDIR dir])
+#                            [KDIR dir] [COVERAGE])
 # Builds the Kbuild module in SOURCE_DIR (its Kbuild file, *.c, *.h and
 # include/) out of tree with W=1 against KDIR (default: the stock kernel's).
+# COVERAGE passes AGNOCAST_COVERAGE=1, which the module's Kbuild turns into
+# gcov and kcov instrumentation (for a kernel built with both).
 # Sets <name>_KO in the caller's scope to the resulting .ko and makes it the
 # target's KO property.
 function(agnocast_add_kernel_module)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "TARGET;SOURCE_DIR;MODULE_NAME;KDIR" "")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "COVERAGE" "TARGET;SOURCE_DIR;MODULE_NAME;KDIR" "")
   if(NOT arg_KDIR)
     set(arg_KDIR "${KDIR}")
   endif()
@@ -81,7 +83,8 @@ function(agnocast_add_kernel_module)
     COMMAND ${CMAKE_COMMAND} -E copy_directory "${arg_SOURCE_DIR}" "${build_dir}"
     COMMAND ${CMAKE_COMMAND} -E rm -rf "${build_dir}/tests"
     COMMAND make -C "${arg_KDIR}" "M=${build_dir}" W=1
-            "AGNOCAST_WERROR=$<BOOL:${AGNOCAST_WERROR}>" modules
+            "AGNOCAST_WERROR=$<BOOL:${AGNOCAST_WERROR}>"
+            "AGNOCAST_COVERAGE=$<BOOL:${arg_COVERAGE}>" modules
     DEPENDS ${sources}
     COMMENT "Building ${arg_MODULE_NAME}.ko against ${arg_KDIR}"
     VERBATIM)

@@ -49,6 +49,7 @@
 //
 // usage: agnocast_fuzz_test [SECONDS [PROCESSES]] [--ops N] [--seed S] [--long]
 //                           [--caps | --no-caps] [--namespaces | --no-namespaces]
+//                           [--unguided]
 //   Runs SECONDS (default 30) and on until N operations (default 0) were
 //   issued.  --long: 4 hours and 10^6 operations, unless given otherwise.
 //   --seed replays the workers' random choices of an earlier run (the
@@ -56,6 +57,10 @@
 //   reloaded with small caps ($AGNOCAST_MODULE, a third of the seeds;
 //   --caps: always, --no-caps: never).  A third of the workers live in the
 //   second IPC namespace; with --no-namespaces threads only visit it.
+//   Under kcov (the debug kernel) the steps are guided by the module's
+//   edges (kcov_guide.h), which it prints over time; --unguided only counts
+//   them.  A guided run replays a seed less closely: kept inputs pass
+//   between processes.
 #include <dirent.h>
 #include <mqueue.h>
 #include <poll.h>
@@ -79,6 +84,7 @@
 #include <shared_mutex>
 #include <tuple>
 
+#include "kcov_guide.h"
 #include "test_util.h"
 
 using namespace agnocast_test;
@@ -249,6 +255,10 @@ struct Shared {
   // Descriptors of the two namespaces (/proc/PID/ns/ipc), open in every
   // worker, kept across exec.
   int ns_fd[kNamespaces];
+  // kcov's edges of the module and the inputs that found them; with
+  // unguided set, edges are counted but no input is replayed.
+  CoverageGuide guide;
+  bool unguided;
 };
 Shared* sh;
 int shared_fd = -1;  // sh's memfd, kept across exec
@@ -457,10 +467,12 @@ int counted_ioctl(int row, int dev, unsigned long cmd, void* arg) {
 }
 
 struct Worker {
-  Worker(uint64_t seed, Process* p, bool owner) : rng(seed), proc(p), owns_registration(owner) {}
-  std::mt19937_64 rng;
+  Worker(uint64_t seed, Process* p, bool owner, KcovTrace* trace)
+      : rng(seed), proc(p), owns_registration(owner), kcov(trace) {}
+  TapedRng rng;
   Process* proc;
   bool owns_registration;
+  KcovTrace* kcov;
   Arena arena;
   std::vector<Ep> pubs, subs;
   std::vector<Held> held;
@@ -1443,6 +1455,20 @@ struct Worker {
     }
   }
 
+  // One step; under kcov (kcov_guide.h) a quarter of them replay a kept
+  // input, changed a little, and a step that makes a new edge is kept.
+  void guided_step() {
+    if (!kcov->start()) {
+      rng.begin();
+      return step();
+    }
+    std::vector<uint64_t> replay;
+    if (!sh->unguided && rng.fresh() % 4 == 0) replay = mutate(sh->guide.pick(rng.fresh()), rng);
+    rng.begin(std::move(replay));
+    step();
+    if (sh->guide.merge(kcov->pcs())) sh->guide.keep(rng.tape());
+  }
+
   // Pauses while the parent audits.
   void maybe_pause() {
     if (!sh->pause.load(std::memory_order_relaxed)) return;
@@ -1459,7 +1485,7 @@ void* thread_main(void* p) {
   auto* w = static_cast<Worker*>(p);
   while (!stop_threads.load(std::memory_order_relaxed)) {
     w->maybe_pause();
-    w->step();
+    w->guided_step();
   }
   return nullptr;
 }
@@ -1489,6 +1515,9 @@ void identity(Process* proc, uint64_t seed) {
 // A worker process: registers (usually), then two threads fuzz until killed.
 [[noreturn]] void worker_process(int slot, uint64_t seed, bool execed) {
   sh->slots[slot].pid = getpid();
+  // Opened while still root, one per thread.
+  auto* kcov_a = new KcovTrace;
+  auto* kcov_b = new KcovTrace;
   auto* proc = new Process;
   proc->slot = slot;
   proc->seed = seed;
@@ -1515,13 +1544,13 @@ void identity(Process* proc, uint64_t seed) {
   std::mt19937_64 rng(seed);
   if (rng() % 10) Worker::register_process(proc, rng() % 10 != 0);
   proc->reset_pool();
-  auto* a = new Worker(seed * 3 + 1, proc, true);
-  auto* b = new Worker(seed * 5 + 2, proc, false);
+  auto* a = new Worker(seed * 3 + 1, proc, true, kcov_a);
+  auto* b = new Worker(seed * 5 + 2, proc, false, kcov_b);
   pthread_t t;
   pthread_create(&t, nullptr, thread_main, b);
   for (uint64_t i = 0;; i++) {
     a->maybe_pause();
-    a->step();
+    a->guided_step();
     // Some workers end on their own, with or without unregistering.
     if (i == 5000 && seed % 3 == 0) {
       if (seed % 2) counted_ioctl(kUnregister, proc->dev, AGNOCAST_IOC_UNREGISTER_PROCESS, nullptr);
@@ -2198,6 +2227,7 @@ int main(int argc, char** argv) {
   int namespaces_arg = -1;
   uint64_t base_seed = 0;
   bool seeded = false;
+  bool unguided = false;
   int positional = 0;
   for (int i = 1; i < argc; i++) {
     std::string a = argv[i];
@@ -2207,6 +2237,8 @@ int main(int argc, char** argv) {
       namespaces_arg = a == "--namespaces";
     } else if (a == "--caps" || a == "--no-caps") {
       caps_arg = a == "--caps";
+    } else if (a == "--unguided") {
+      unguided = true;
     } else if (a == "--ops" && i + 1 < argc) {
       min_ops = std::atoll(argv[++i]);
     } else if (a == "--seed" && i + 1 < argc) {
@@ -2230,6 +2262,15 @@ int main(int argc, char** argv) {
   if (shared_fd < 0 || ftruncate(shared_fd, sizeof(Shared))) return 2;
   sh = static_cast<Shared*>(
       mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED, shared_fd, 0));
+  sh->unguided = unguided;
+  // kcov lives in debugfs (the debug kernel has it): mounted if need be.
+  if (access("/sys/kernel/debug/kcov", F_OK))
+    mount("debugfs", "/sys/kernel/debug", "debugfs", 0, nullptr);
+  const bool kcov = KcovTrace().available();
+  std::printf("fuzz: kcov: %s\n", !kcov      ? "not in this kernel: unguided, no edges counted"
+                                  : unguided ? "edges counted, unguided (--unguided)"
+                                             : "edges counted, guiding the steps");
+  std::fflush(stdout);
   std::mt19937_64 rng(base_seed);
   bool ok = true;
   // Workers in the second namespace find wrong messages there (tests/README.md,
@@ -2320,6 +2361,10 @@ int main(int argc, char** argv) {
   auto next_audit = start + std::chrono::seconds(1);
   auto next_reload = start + std::chrono::seconds(2);
   auto next_report = start + std::chrono::seconds(600);
+  // kcov's edges after 1, 2, 4, ... s, then every 10 minutes: whether a long
+  // run still finds code.
+  auto edges_interval = std::chrono::seconds(1);
+  auto next_edges_report = start + edges_interval;
   while (std::chrono::steady_clock::now() < deadline ||
          sh->ops.load() < static_cast<uint64_t>(min_ops)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50 + rng() % 200));
@@ -2358,6 +2403,18 @@ int main(int argc, char** argv) {
                       std::chrono::duration_cast<std::chrono::seconds>(now - start).count()));
       std::fflush(stdout);
       next_report = now + std::chrono::seconds(600);
+    }
+    if (kcov && now >= next_edges_report) {
+      std::printf("fuzz: kcov: %llu edges after %lld s and %llu operations, %llu inputs kept\n",
+                  static_cast<unsigned long long>(sh->guide.edges.load()),
+                  static_cast<long long>(
+                      std::chrono::duration_cast<std::chrono::seconds>(now - start).count()),
+                  static_cast<unsigned long long>(sh->ops.load()),
+                  static_cast<unsigned long long>(sh->guide.inputs.load()));
+      std::fflush(stdout);
+      edges_interval =
+          std::min<std::chrono::seconds>(edges_interval * 2, std::chrono::seconds(600));
+      next_edges_report = now + edges_interval;
     }
     if (rng() % 3) continue;
     int i = static_cast<int>(rng() % nprocs);
@@ -2524,15 +2581,29 @@ int main(int argc, char** argv) {
     std::printf("fuzz: FAIL: %s never succeeded\n", kRowNames[r]);
     ok = false;
   }
+  if (kcov) {
+    std::printf("fuzz: kcov: %llu edges of the module in %llu operations, %llu inputs kept%s\n",
+                static_cast<unsigned long long>(sh->guide.edges.load()),
+                static_cast<unsigned long long>(sh->ops.load()),
+                static_cast<unsigned long long>(sh->guide.inputs.load()),
+                unguided ? " (unguided)" : "");
+    if (!sh->guide.edges) {
+      std::printf(
+          "fuzz: FAIL: kcov counted no edge: is the module built with KCOV_INSTRUMENT "
+          "(AGNOCAST_COVERAGE=1)?\n");
+      ok = false;
+    }
+  }
   if (sh->failures) {
     std::printf("fuzz: FAIL: %llu wrong messages (see above)\n",
                 static_cast<unsigned long long>(sh->failures.load()));
     ok = false;
   }
   if (!clean) ok = false;
-  std::printf("fuzz: %s (seed %llu; replay: agnocast_fuzz_test %d %d --ops %lld --seed %llu%s%s)\n",
-              ok ? "PASS" : "FAIL", static_cast<unsigned long long>(base_seed), seconds, nprocs,
-              min_ops, static_cast<unsigned long long>(base_seed), caps ? " --caps" : " --no-caps",
-              namespaces ? " --namespaces" : " --no-namespaces");
+  std::printf(
+      "fuzz: %s (seed %llu; replay: agnocast_fuzz_test %d %d --ops %lld --seed %llu%s%s%s)\n",
+      ok ? "PASS" : "FAIL", static_cast<unsigned long long>(base_seed), seconds, nprocs, min_ops,
+      static_cast<unsigned long long>(base_seed), caps ? " --caps" : " --no-caps",
+      namespaces ? " --namespaces" : " --no-namespaces", unguided ? " --unguided" : "");
   return ok ? 0 : 1;
 }

@@ -44,6 +44,10 @@ class KcovTrace {
     }
     area_ = static_cast<std::atomic<uint64_t>*>(area);
   }
+  ~KcovTrace() {
+    if (area_) munmap(area_, kMaxPcs * sizeof(uint64_t));
+    if (fd_ >= 0) close(fd_);
+  }
   KcovTrace(const KcovTrace&) = delete;
   KcovTrace& operator=(const KcovTrace&) = delete;
 

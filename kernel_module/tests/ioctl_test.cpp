@@ -950,6 +950,18 @@ TEST_F(Device, Reclaim) {
   EXPECT_EQ(addrs[0], reg.addr + 16);
 }
 
+// SHED answers a registered process only, into memory it can write; with
+// nothing held it sheds nothing.
+TEST_F(Device, ShedErrors) {
+  auto arg = poisoned<agnocast_shed>();
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_SHED, &arg), -ESRCH);
+  registered();
+  EXPECT_EQ(ioc(dev, AGNOCAST_IOC_SHED, static_cast<agnocast_shed*>(kBadPtr)), -EFAULT);
+  ASSERT_EQ(ioc(dev, AGNOCAST_IOC_SHED, &arg), 0);
+  EXPECT_EQ(arg.shed, 0u);
+  EXPECT_EQ(arg.reclaimable, 0u);
+}
+
 TEST_F(Device, ReceiveErrors) {
   registered();
   Endpoint pub, sub;

@@ -260,9 +260,13 @@ TEST(Services, AThousandClientsComeAndGoAndTheServerReturnsToItsBaseline) {
   const auto requests = agnocast::topic_info(agnocast::service_request_topic(name));
   ASSERT_TRUE(requests);
   EXPECT_TRUE(requests->publishers.empty());
-  // 100 + 800 + 99 + 1; the killed one's request counts as a failure when its
-  // publisher was gone before the server saw it.
-  EXPECT_EQ(service->calls() + service->failures(), 1001U);
+  // 100 + 800 + 99 + 1 requests are calls, but for the killed client's: a
+  // refusal (a failure) when its publisher was gone before the server saw
+  // it, else a call whose response is a failure too if the kill came first.
+  EXPECT_GE(service->calls(), 1000U);
+  EXPECT_LE(service->calls(), 1001U);
+  EXPECT_LE(service->failures(), 1U);
+  EXPECT_GE(service->calls() + service->failures(), 1001U);
 }
 
 TEST(Services, AClientOfAnotherTypeIsRefused) {

@@ -1,5 +1,6 @@
 #include "cli.hpp"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <exception>
 #include <string_view>

@@ -2,7 +2,6 @@
 // and turns every failure into the CLI's exit codes (0, 1 runtime, 2 usage).
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -11,6 +10,12 @@
 #include <string>
 
 #include "inspection_source.hpp"
+
+// Only the files that wire options include CLI11, whose header alone costs
+// seconds of compile time in every file that includes it.
+namespace CLI {
+class App;
+}
 
 namespace agnocast::cli {
 

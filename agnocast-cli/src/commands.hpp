@@ -3,7 +3,6 @@
 // the table renderers of those values. Shapes: agnocast-cli/README.md.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstddef>
 #include <nlohmann/json.hpp>
 #include <optional>

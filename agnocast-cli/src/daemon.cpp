@@ -1,6 +1,7 @@
 // agnocast-cli daemon status: agnocastd's own status file (<agnocast/status.hpp>),
 // then agnocast-bridge's and agnocast-foxglove's, each checked against its lock
 // so a crashed daemon shows as stopped.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <cstdint>

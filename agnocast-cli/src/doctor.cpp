@@ -2,6 +2,7 @@
 // detail that says what is wrong and how to fix it. Exit 1 if any fails.
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cstring>
 #include <sstream>
 

@@ -1,5 +1,6 @@
 // agnocast-cli node list | info NODE: endpoints grouped by process and node
 // label; those on the topics that carry a service count as serving or calling it.
+#include <CLI/CLI.hpp>
 #include <map>
 #include <set>
 #include <utility>

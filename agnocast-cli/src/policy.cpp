@@ -1,6 +1,7 @@
 // agnocast-cli policy show: the access policy the kernel enforces in this IPC
 // namespace (agnocastd/README.md, "access"), its rules as agnocastd's config
 // writes them (services rules included), user and group ids shown by name.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
 #include <string>

@@ -4,6 +4,7 @@
 // how much of the pool is in use is what the process has touched of it, the
 // pool mapping's resident size in /proc/PID/smaps (null where /proc does not
 // tell this user).
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <map>

@@ -1,6 +1,7 @@
 // agnocast-cli queue list: every agnocast-pattern notification queue but
 // those of services, its depth read with mq_getattr, and whether a live
 // subscriber still owns it.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <map>
 #include <utility>

@@ -1,5 +1,6 @@
 // agnocast-cli service list | info NAME | type NAME: services seen through the
 // two topics that carry each one (<agnocast/naming.hpp>), read like any topic.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <map>
 #include <utility>

@@ -1,6 +1,7 @@
 // agnocast-cli service call NAME TYPE [JSON] [--timeout S] [--json]
 #include "service_call.hpp"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <sstream>

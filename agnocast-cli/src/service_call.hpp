@@ -4,7 +4,6 @@
 // kernel keeps each endpoint's schema), so any service type can be called.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstddef>
 #include <cstdint>
 #include <functional>

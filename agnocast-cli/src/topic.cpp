@@ -1,5 +1,6 @@
 // agnocast-cli topic list | info TOPIC (hz: topic_hz.cpp, delay: topic_delay.cpp, echo:
 // echo.cpp)
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

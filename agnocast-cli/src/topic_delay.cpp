@@ -6,6 +6,7 @@
 // session is needed. A subscriber is sampled ten times a second: one that
 // takes more than 1,024 messages between two samples has some counted but
 // not timed (`missed`).
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

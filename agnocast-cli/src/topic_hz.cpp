@@ -3,6 +3,7 @@
 // per-publisher counters. It never subscribes: the counters are sampled every
 // millisecond, and the messages a sample finds are spread evenly over the
 // millisecond before it, so periods are exact to about a millisecond.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,6 @@
 #include "topic_windows.hpp"
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 

@@ -3,7 +3,6 @@
 // JSON Lines, and the options that say so.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstddef>
 #include <functional>
 #include <nlohmann/json.hpp>

@@ -1,6 +1,8 @@
 // agnocast-cli version: the CLI's, the library's and the loaded module's versions.
 #include "agnocast/version.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include "commands.hpp"
 #include "table.hpp"
 

@@ -178,7 +178,9 @@ int main(int argc, char** argv) {
     wheel->tire.brand = "a brand name longer than a small string buffer";
     wheel->radius = 0.25 + i;
     wheel->speeds.assign(static_cast<std::size_t>(i), 1.5F);
-    wheel->tags.push_back(("t" + std::to_string(i)).c_str());
+    // Appended, not "t" + to_string(i): GCC 12 at -O3 warns falsely (-Wrestrict) on that form.
+    const std::string tag = std::string("t").append(std::to_string(i));
+    wheel->tags.push_back(tag.c_str());
     wheel->flags = {1, 0, static_cast<std::uint8_t>(i % 2)};
     wheel->enabled = i % 2 == 0;
     wheel->spares[1].brand = "spare";

@@ -1,6 +1,7 @@
 // agnocast-cli bag: record, info and play, wired into CLI11.
 #include "bag/bag.hpp"
 
+#include <CLI/CLI.hpp>
 #include <memory>
 
 #include "agnocast/naming.hpp"

@@ -3,7 +3,6 @@
 // on the live system and on files, not through an InspectionSource.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>

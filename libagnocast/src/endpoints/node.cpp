@@ -9,6 +9,7 @@
 
 #include "agnocast/limits.hpp"
 #include "endpoints/node_state.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast {
 namespace {
@@ -28,6 +29,9 @@ void validate_node_name(const std::string& name) {
 Node::Node(std::string name) {
   validate_node_name(name);
   state_ = std::make_shared<detail::NodeState>(std::move(name));
+  AGNOCAST_TRACE(agnocast_node_init, state_.get(), state_->name.c_str());
+  AGNOCAST_TRACE(agnocast_callback_group_init, state_->default_group.get(), state_.get(),
+                 "mutually_exclusive");
 }
 
 Node::~Node() = default;
@@ -35,7 +39,10 @@ Node::~Node() = default;
 const std::string& Node::get_name() const { return state_->name; }
 
 std::shared_ptr<CallbackGroup> Node::create_callback_group(CallbackGroupType type) {
-  return std::make_shared<CallbackGroup>(type);
+  auto group = std::make_shared<CallbackGroup>(type);
+  AGNOCAST_TRACE(agnocast_callback_group_init, group.get(), state_.get(),
+                 type == CallbackGroupType::Reentrant ? "reentrant" : "mutually_exclusive");
+  return group;
 }
 
 const std::shared_ptr<CallbackGroup>& Node::get_default_callback_group() const {
@@ -47,6 +54,8 @@ std::shared_ptr<Timer> Node::create_timer(std::chrono::nanoseconds period,
                                           std::shared_ptr<CallbackGroup> group) {
   auto timer = std::make_shared<Timer>(period, std::move(callback),
                                        detail::group_or_default(*state_, std::move(group)));
+  AGNOCAST_TRACE(agnocast_timer_init, timer.get(), state_.get(), timer->group().get(),
+                 static_cast<std::int64_t>(period.count()));
   detail::register_waitable(*state_, timer);
   return timer;
 }

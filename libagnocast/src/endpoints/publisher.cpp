@@ -17,6 +17,7 @@
 #include "endpoints/notification_queue.hpp"
 #include "kernel/runtime.hpp"
 #include "log_internal.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast::detail {
 
@@ -42,6 +43,8 @@ PublisherCore::PublisherCore(std::shared_ptr<NodeState> node, std::string_view t
   const EndpointRequest request =
       make_endpoint_request(node->name, topic, qos, EndpointKind::publisher, type, use);
   state_ = std::make_unique<State>(std::move(node), Runtime::get(), request);
+  AGNOCAST_TRACE(agnocast_publisher_init, this, state_->node.get(), state_->topic.c_str(),
+                 qos.depth(), state_->endpoint.id);
 }
 
 PublisherCore::~PublisherCore() {
@@ -111,6 +114,8 @@ void PublisherCore::publish(void* message, std::size_t bytes, const ServiceRoute
         throw;
       }
     }
+    // Before the wake-ups: a subscriber's take never precedes its publish.
+    AGNOCAST_TRACE(agnocast_publish, this, static_cast<std::int64_t>(result.entry_id));
     for (std::uint32_t i = 0; i < result.wake_count; ++i) {
       if (!state.senders.notify(state.wake_ids[i])) {
         state.runtime.kernel().notify_failed(state.endpoint, state.wake_ids[i]);

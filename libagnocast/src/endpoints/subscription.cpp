@@ -22,6 +22,7 @@
 #include "endpoints/notification_queue.hpp"
 #include "kernel/runtime.hpp"
 #include "log_internal.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -338,6 +339,8 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
+  AGNOCAST_TRACE(agnocast_subscription_init, this, state_->node.get(), this, group().get(),
+                 type.name.data(), state_->topic.c_str(), qos.depth(), callable_id(id()), id());
   // A service's carriers are not topics anyone asks the delay of.
   state_->delays = use == TopicUse::application
                        ? std::make_unique<DelayRecorder>(state_->topic, state_->endpoint->id().id)
@@ -430,7 +433,12 @@ std::size_t SubscriptionBase::handle_wakeup() {
         const std::size_t i = handed_out++;
         const MessageInfo info = info_of(runtime, entries[i]);
         state.delays->record(info.publish_time);
-        deliver(reinterpret_cast<const void*>(entries[i].addr), references[i], info);
+        const auto* message = reinterpret_cast<const void*>(entries[i].addr);
+        AGNOCAST_TRACE(agnocast_take, this, message, static_cast<std::int64_t>(info.entry_id));
+        AGNOCAST_TRACE(agnocast_create_callable, this, static_cast<std::int64_t>(info.entry_id),
+                       callable_id(id()));
+        const TracedCallable callable(this);
+        deliver(message, references[i], info);
         ++delivered;
       }
     } catch (...) {
@@ -462,6 +470,8 @@ PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
+  AGNOCAST_TRACE(agnocast_subscription_init, this, state_->node.get(), nullptr, nullptr,
+                 type.name.data(), state_->topic.c_str(), qos.depth(), callable_id(id()), id());
 }
 
 PollingCore::~PollingCore() {
@@ -489,6 +499,8 @@ bool PollingCore::take_newer() {
   }
   grants.unlock();
   if (!reference) return false;
+  AGNOCAST_TRACE(agnocast_take, this, reinterpret_cast<const void*>(taken.entry.addr),
+                 static_cast<std::int64_t>(taken.entry.entry_id));
   if (state_->latest.reference) release(state_->latest.reference);
   state_->latest = TakenEntry{reinterpret_cast<const void*>(taken.entry.addr), reference};
   return true;

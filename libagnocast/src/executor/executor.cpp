@@ -25,6 +25,7 @@
 #include "endpoints/notification_queue.hpp"
 #include "kernel/runtime.hpp"
 #include "signals_internal.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast {
 namespace {
@@ -196,7 +197,9 @@ struct Executor::State {
       }
     }
     epoll_event event{};
+    AGNOCAST_TRACE(agnocast_executor_wait, this, static_cast<std::int32_t>(timeout_ms));
     const int ready = ::epoll_wait(epoll_fd, &event, 1, timeout_ms);
+    AGNOCAST_TRACE(agnocast_executor_wake, this, static_cast<std::int32_t>(ready));
     if (ready < 0) {
       if (errno == EINTR) return Outcome::idle;
       throw Error(std::string("agnocast: epoll_wait: ") + std::strerror(errno));
@@ -285,7 +288,11 @@ void Executor::run_in_group(detail::PendingWork work) {
   }
 }
 
-Executor::Executor(bool parallel) : state_(std::make_unique<State>(parallel)) {}
+// The executor's events name it by its state, which its waits know.
+Executor::Executor(bool parallel) : state_(std::make_unique<State>(parallel)) {
+  AGNOCAST_TRACE(agnocast_construct_executor, state_.get(),
+                 parallel ? "multi_threaded_executor" : "single_threaded_executor");
+}
 Executor::~Executor() = default;
 
 void Executor::add_node(Node& node) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "agnocast/errors.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast {
 namespace {
@@ -64,6 +65,7 @@ void Timer::execute() {
   // Nothing to read: cancel() or reset() cleared the expiry after epoll saw it.
   if (::read(fd_, &expirations, sizeof expirations) != sizeof expirations) return;
   if (canceled_) return;
+  const detail::TracedCallable traced(this);
   callback_();
 }
 

@@ -13,14 +13,24 @@ _agnocast_cli() {
     [[ $word == -* ]] || words+=("$word")
   done
   case $prev in
-    --window | --count | --timeout | --status-file | --bridge-status-file | --foxglove-status-file | --max-size | --duration | --rate | --start-offset) return ;;
+    --window | --count | --timeout | --status-file | --bridge-status-file | --foxglove-status-file | --max-size | --duration | --rate | --start-offset | --topics | --path) return ;;
     --compression) COMPREPLY=($(compgen -W "zstd lz4 none" -- "$cur")); return ;;
     -o | --output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
   esac
   local candidates
   case "${words[0]-} ${words[1]-}" in
-    " ") candidates="topic service queue node process daemon doctor policy bag version --json --help --version" ;;
+    " ") candidates="topic service queue node process daemon doctor policy bag trace version --json --help --version" ;;
     "bag ") candidates="record info play" ;;
+    "trace ") candidates="record report" ;;
+    "trace record") candidates="--duration --output --topics --json --help" ;;
+    "trace report")
+      if [[ $cur == -* ]]; then
+        candidates="--path --json --help"
+      else
+        COMPREPLY=($(compgen -f -- "$cur"))
+        return
+      fi
+      ;;
     "bag record")
       if [[ $cur == -* ]]; then
         candidates="--output --all --compression --max-size --duration --json --help"

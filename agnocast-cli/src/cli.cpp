@@ -7,6 +7,7 @@
 
 #include "bag/bag.hpp"
 #include "commands.hpp"
+#include "trace/trace.hpp"
 
 namespace agnocast::cli {
 namespace {
@@ -119,6 +120,7 @@ int run_cli(int argc, const char* const* argv_given, InspectionSource& source, s
   set_policy_command(app, context);
   set_version_command(app, context);
   set_bag_command(app, context);
+  set_trace_command(app, context);
   // Shown in --help; run_cli turns it into the version command before parsing.
   app.add_flag("--version")->description("Same as the version command");
 

@@ -24,10 +24,18 @@ struct Endpoint {
   std::string node;
 };
 
+// A subscription's take, which its callable_start follows on the thread.
+struct Take {
+  std::int64_t subscription = 0;
+  std::int64_t entry = 0;
+  std::string topic;
+  std::uint32_t subscriber_id = 0;
+};
+
 struct Open {
   std::int64_t callable = 0;
   std::int64_t start_ns = 0;
-  std::optional<std::int64_t> entry;
+  std::optional<Take> take;
 };
 
 struct Publish {
@@ -35,6 +43,13 @@ struct Publish {
   int tid = 0;
   std::int64_t time_ns = 0;
 };
+
+std::string node_of(const std::map<std::pair<std::string, std::uint32_t>, std::string>& nodes,
+                    const std::string& topic, std::optional<std::int64_t> id) {
+  if (!id) return {};
+  const auto found = nodes.find({topic, static_cast<std::uint32_t>(*id)});
+  return found == nodes.end() ? std::string() : found->second;
+}
 
 class Converter {
  public:
@@ -102,29 +117,38 @@ class Converter {
     see(event);
     const std::pair<int, int> thread{event.pid, event.tid};
     if (event.name == "agnocast_publish") {
-      const auto found =
-          publishers_.find({event.pid, event.number("publisher_handle").value_or(0)});
-      if (found == publishers_.end() || !wanted(found->second.topic)) return;
+      const auto known = publishers_.find({event.pid, event.number("publisher_handle").value_or(0)});
+      std::string topic = event.text("topic_name");
+      if (topic.empty() && known != publishers_.end()) topic = known->second.topic;
+      if (topic.empty() || !wanted(topic)) return;
+      const std::string node =
+          known != publishers_.end()
+              ? known->second.node
+              : node_of(trace_.publisher_nodes, topic, event.number("publisher_id"));
       const std::int64_t entry = event.number("entry_id").value_or(0);
-      publishes_[{found->second.topic, entry}] = {event.pid, event.tid, event.time_ns};
-      events_.push_back(
-          {{"ph", "X"},
-           {"cat", "publish"},
-           {"name", "publish " + found->second.topic},
-           {"pid", event.pid},
-           {"tid", event.tid},
-           {"ts", micros(event.time_ns)},
-           {"dur", 0},
-           {"args",
-            {{"topic", found->second.topic}, {"node", found->second.node}, {"entry_id", entry}}}});
+      publishes_[{topic, entry}] = {event.pid, event.tid, event.time_ns};
+      events_.push_back({{"ph", "X"},
+                         {"cat", "publish"},
+                         {"name", "publish " + topic},
+                         {"pid", event.pid},
+                         {"tid", event.tid},
+                         {"ts", micros(event.time_ns)},
+                         {"dur", 0},
+                         {"args", {{"topic", topic}, {"node", node}, {"entry_id", entry}}}});
     } else if (event.name == "agnocast_take") {
-      last_take_[thread] = {event.number("subscription_handle").value_or(0),
-                            event.number("entry_id").value_or(0)};
+      Take take{event.number("subscription_handle").value_or(0),
+                event.number("entry_id").value_or(0), event.text("topic_name"),
+                static_cast<std::uint32_t>(event.number("subscriber_id").value_or(0))};
+      if (take.topic.empty()) {
+        const auto known = subscriptions_.find({event.pid, take.subscription});
+        if (known != subscriptions_.end()) take.topic = known->second.topic;
+      }
+      last_take_[thread] = std::move(take);
     } else if (event.name == "agnocast_callable_start") {
       Open open{event.number("callable").value_or(0), event.time_ns, std::nullopt};
       const auto take = last_take_.find(thread);
-      if (take != last_take_.end() && take->second.first == open.callable) {
-        open.entry = take->second.second;
+      if (take != last_take_.end() && take->second.subscription == open.callable) {
+        open.take = std::move(take->second);
         last_take_.erase(take);
       }
       open_[thread].push_back(open);
@@ -159,16 +183,29 @@ class Converter {
     const Handle handle{end.pid, open.callable};
     json args;
     std::string name;
-    if (const auto sub = subscriptions_.find(handle); sub != subscriptions_.end()) {
+    const auto sub = subscriptions_.find(handle);
+    if (open.take && !open.take->topic.empty()) {
+      const Take& take = *open.take;
+      if (!wanted(take.topic)) return;
+      name = "callback " + take.topic;
+      args = {{"topic", take.topic},
+              {"node", sub != subscriptions_.end()
+                           ? sub->second.node
+                           : node_of(trace_.subscriber_nodes, take.topic, take.subscriber_id)},
+              {"entry_id", take.entry}};
+    } else if (sub != subscriptions_.end()) {
       if (!wanted(sub->second.topic)) return;
       name = "callback " + sub->second.topic;
       args = {{"topic", sub->second.topic}, {"node", sub->second.node}};
-      if (open.entry) args["entry_id"] = *open.entry;
     } else if (const auto timer = timers_.find(handle); timer != timers_.end()) {
       name = timer->second.topic;
       args = {{"node", timer->second.node}};
     } else {
-      return;  // made before the recording began: nothing names it
+      // A timer made before the recording began: nothing names it.
+      char text[32];
+      std::snprintf(text, sizeof text, "0x%llx", static_cast<unsigned long long>(open.callable));
+      name = "callback";
+      args = {{"callable", text}};
     }
     ++callbacks_;
     events_.push_back({{"ph", "X"},
@@ -179,29 +216,19 @@ class Converter {
                        {"ts", micros(open.start_ns)},
                        {"dur", micros(end.time_ns - open.start_ns)},
                        {"args", args}});
-    if (!open.entry) return;
-    const std::string topic = args["topic"];
-    const auto publish = publishes_.find({topic, *open.entry});
+    if (!open.take || open.take->topic.empty()) return;
+    const std::string& topic = open.take->topic;
+    const std::int64_t entry = open.take->entry;
+    const auto publish = publishes_.find({topic, entry});
     if (publish == publishes_.end()) return;
     const std::uint64_t id = ++flows_;
     const Publish& from = publish->second;
-    events_.push_back({{"ph", "s"},
-                       {"cat", "flow"},
-                       {"name", topic},
-                       {"id", id},
-                       {"pid", from.pid},
-                       {"tid", from.tid},
-                       {"ts", micros(from.time_ns)},
-                       {"args", {{"entry_id", *open.entry}}}});
-    events_.push_back({{"ph", "f"},
-                       {"bp", "e"},
-                       {"cat", "flow"},
-                       {"name", topic},
-                       {"id", id},
-                       {"pid", end.pid},
-                       {"tid", end.tid},
-                       {"ts", micros(open.start_ns)},
-                       {"args", {{"entry_id", *open.entry}, {"node", args["node"]}}}});
+    events_.push_back({{"ph", "s"}, {"cat", "flow"}, {"name", topic}, {"id", id},
+                       {"pid", from.pid}, {"tid", from.tid}, {"ts", micros(from.time_ns)},
+                       {"args", {{"entry_id", entry}}}});
+    events_.push_back({{"ph", "f"}, {"bp", "e"}, {"cat", "flow"}, {"name", topic}, {"id", id},
+                       {"pid", end.pid}, {"tid", end.tid}, {"ts", micros(open.start_ns)},
+                       {"args", {{"entry_id", entry}, {"node", args["node"]}}}});
   }
 
   void kernel_instant(const TraceEvent& event) {
@@ -262,7 +289,7 @@ class Converter {
   std::map<Handle, std::string> nodes_;
   std::map<Handle, Endpoint> publishers_, subscriptions_, timers_;
   std::map<std::pair<std::string, std::int64_t>, Publish> publishes_;  // by topic and entry
-  std::map<std::pair<int, int>, std::pair<std::int64_t, std::int64_t>> last_take_;
+  std::map<std::pair<int, int>, Take> last_take_;
   std::map<std::pair<int, int>, std::vector<Open>> open_;
   std::map<std::pair<int, int>, std::int64_t> waits_;
   std::map<int, std::string> process_names_;

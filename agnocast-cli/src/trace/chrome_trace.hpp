@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
@@ -28,6 +29,9 @@ struct RecordedTrace {
   std::vector<TraceEvent> library;  // parse_lttng_text()
   std::vector<TraceEvent> kernel;   // parse_tracefs_text()
   std::vector<EntryCounts> counts;
+  // Node names by topic and endpoint id, from the kernel: they name what a
+  // process made before the recording began (its init events are not in it).
+  std::map<std::pair<std::string, std::uint32_t>, std::string> publisher_nodes, subscriber_nodes;
   std::optional<std::regex> topics;  // only the topics this matches, when set
 };
 

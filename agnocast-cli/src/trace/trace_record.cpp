@@ -14,9 +14,11 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <vector>
 
+#include "agnocast/signals.hpp"
 #include "cli.hpp"
 #include "trace/chrome_trace.hpp"
 
@@ -110,7 +112,7 @@ class LttngSession {
  public:
   explicit LttngSession(const fs::path& folder)
       : name_("agnocast-cli-" + std::to_string(::getpid())), folder_(folder) {
-    if (run({"lttng", "list"}) != 0) start_daemon();
+    if (run({"lttng", "--no-sessiond", "list"}) != 0) start_daemon();
     lttng({"create", name_, "--output=" + folder_.string()});
     created_ = true;
     lttng({"enable-event", "--userspace", "agnocast:*", "--session=" + name_});
@@ -135,11 +137,12 @@ class LttngSession {
   bool started_daemon() const { return daemon_ > 0; }
 
  private:
+  // Never lets lttng start a daemon itself: this session manages its own.
   void lttng(std::vector<std::string> args) {
-    args.insert(args.begin(), "lttng");
+    args.insert(args.begin(), {"lttng", "--no-sessiond"});
     std::string output;
     if (run(args, &output) != 0) {
-      throw CliError("lttng " + args[1] + " failed: " + output);
+      throw CliError("lttng " + args[2] + " failed: " + output);
     }
   }
 
@@ -152,22 +155,35 @@ class LttngSession {
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-    const int spawned = ::posix_spawnp(&daemon_, argv[0], &actions, nullptr,
+    // A group of its own: the terminal's Ctrl-C, which ends the recording,
+    // must not end the daemon before the recording is stopped and read.
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0);
+    const int spawned = ::posix_spawnp(&daemon_, argv[0], &actions, &attributes,
                                        const_cast<char* const*>(argv), environ);
+    posix_spawnattr_destroy(&attributes);
     posix_spawn_file_actions_destroy(&actions);
     if (spawned != 0) {
       daemon_ = 0;
       throw CliError(std::string("cannot start lttng-sessiond: ") + std::strerror(spawned));
     }
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      if (run({"lttng", "list"}) == 0) {
-        // Let the running processes register before the session starts.
+    for (int attempt = 0; attempt < 600; ++attempt) {
+      int status = 0;
+      if (::waitpid(daemon_, &status, WNOHANG) == daemon_) {
+        daemon_ = 0;
+        throw CliError("lttng-sessiond exited at once (status " + std::to_string(status) +
+                       "): run lttng-sessiond -vv to see why");
+      }
+      if (run({"lttng", "--no-sessiond", "list"}) == 0) {
+        // Let the processes that start now register before the session starts.
         ::usleep(500'000);
         return;
       }
       ::usleep(50'000);
     }
-    throw CliError("lttng-sessiond did not come up within 5 s");
+    throw CliError("lttng-sessiond did not answer within 30 s");
   }
 
   const std::string name_;
@@ -248,6 +264,16 @@ struct TempFolder {
   }
 };
 
+// The agnocast processes alive now, when the module can be asked.
+std::set<int> agnocast_pids(InspectionSource& source) {
+  std::set<int> pids;
+  try {
+    for (const ProcessInfo& process : source.list_processes()) pids.insert(process.pid);
+  } catch (const std::exception&) {
+  }
+  return pids;
+}
+
 std::string default_output() {
   const std::time_t now = std::time(nullptr);
   std::tm local{};
@@ -260,7 +286,7 @@ std::string default_output() {
 // One sample of every topic's counts; what went wrong, when the module
 // cannot be asked (the recording goes on without counts).
 std::string sample_counts(InspectionSource& source, const std::optional<std::regex>& topics,
-                          std::vector<EntryCounts>& counts) try {
+                          RecordedTrace& trace) try {
   const std::int64_t now = monotonic_ns();
   for (const TopicSummary& summary : source.list_topics()) {
     if (topics && !std::regex_search(summary.name, *topics)) continue;
@@ -270,8 +296,12 @@ std::string sample_counts(InspectionSource& source, const std::optional<std::reg
     for (const SubscriberInfo& subscriber : info->subscribers) {
       sample.held += subscriber.held;
       sample.unreceived += subscriber.unreceived;
+      trace.subscriber_nodes[{summary.name, subscriber.id}] = subscriber.node;
     }
-    counts.push_back(sample);
+    for (const PublisherInfo& publisher : info->publishers) {
+      trace.publisher_nodes[{summary.name, publisher.id}] = publisher.node;
+    }
+    trace.counts.push_back(sample);
   }
   return {};
 } catch (const std::exception& error) {
@@ -312,7 +342,13 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
     throw CliError("cannot write " + output + ": give -o a file in a folder you can write");
   }
 
+  install_signal_handlers();  // SIGINT/SIGTERM end the recording, which is then written
+  const std::set<int> running = agnocast_pids(source);
   TempFolder folder;
+  // LTTng's tools keep their settings in a home folder; a service has none.
+  if (!std::getenv("HOME") && !std::getenv("LTTNG_HOME")) {
+    ::setenv("LTTNG_HOME", folder.path.c_str(), 1);
+  }
   KernelEvents kernel;
   std::string kernel_problem = kernel.problem();
   std::string counts_problem;
@@ -321,7 +357,7 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
     const double start = source.now_seconds();
     while (!source.stop_requested() &&
            (!options.duration_s || source.now_seconds() - start < *options.duration_s)) {
-      if (std::string problem = sample_counts(source, trace.topics, trace.counts);
+      if (std::string problem = sample_counts(source, trace.topics, trace);
           !problem.empty() && counts_problem.empty()) {
         counts_problem = std::move(problem);
       }
@@ -331,7 +367,7 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
       }
       source.sleep_seconds(wait);
     }
-    sample_counts(source, trace.topics, trace.counts);
+    sample_counts(source, trace.topics, trace);
     session.stop();
     trace.kernel = kernel.take();
   }
@@ -343,6 +379,12 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
     }
     trace.library = parse_lttng_text(text);
   }
+  // Processes that lived throughout and sent nothing carry no probes: they
+  // started while no session daemon listened (libagnocast/README.md, "Tracing").
+  std::set<int> silent = running;
+  for (const TraceEvent& event : trace.library) silent.erase(event.pid);
+  const std::set<int> alive = agnocast_pids(source);
+  std::erase_if(silent, [&](int pid) { return !alive.contains(pid); });
   const nlohmann::json chrome = chrome_trace(trace);
   {
     std::ofstream file(output, std::ios::trunc);
@@ -357,7 +399,8 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
       {"callbacks", other["callbacks"]},
       {"flows", other["flows"]},
       {"kernel", kernel_problem.empty() ? nlohmann::json(true) : nlohmann::json(kernel_problem)},
-      {"counts", counts_problem.empty() ? nlohmann::json(true) : nlohmann::json(counts_problem)}};
+      {"counts", counts_problem.empty() ? nlohmann::json(true) : nlohmann::json(counts_problem)},
+      {"silent_pids", silent}};
   if (options.json) {
     out << summary.dump() << '\n';
   } else {
@@ -366,6 +409,14 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
         << other["flows"] << " flows from publish to callback\n";
     if (!kernel_problem.empty()) out << "kernel events left out: " << kernel_problem << '\n';
     if (!counts_problem.empty()) out << "entry counts left out: " << counts_problem << '\n';
+    if (!silent.empty()) {
+      out << silent.size()
+          << " agnocast processes sent no events, having started while no LTTng session daemon "
+             "ran (pids";
+      for (const int pid : silent) out << ' ' << pid;
+      out << "): start lttng-sessiond before them (systemctl start lttng-sessiond), or start "
+             "them with AGNOCAST_LTTNG=1\n";
+    }
     if (trace.library.empty()) {
       out << "no library events: no agnocast process ran, or libagnocast was built with "
              "AGNOCAST_TRACING=OFF\n";

@@ -58,20 +58,24 @@ std::string pipeline_text() {
     const double t = 1000.0 * (k + 1);
     const std::string a = std::to_string(k + 1), b = std::to_string(k + 11);
     add(t, 100, 100, "talker", "agnocast_callable_start", "callable = 0x30");
-    add(t + 1, 100, 100, "talker", "agnocast_publish", "publisher_handle = 0x20, entry_id = " + a);
+    add(t + 1, 100, 100, "talker", "agnocast_publish",
+        "publisher_handle = 0x20, entry_id = " + a + ", topic_name = \"/a\", publisher_id = 1");
     add(t + 2, 100, 100, "talker", "agnocast_callable_end", "callable = 0x30");
     // The relay takes 10 µs (first) and 30 µs (second) to start.
     const double r = t + 1 + 10 + 20 * k;
     add(r - 1, 200, 201, "relay", "agnocast_take",
-        "subscription_handle = 0x40, message = 0x7000, entry_id = " + a);
+        "subscription_handle = 0x40, message = 0x7000, entry_id = " + a +
+            ", topic_name = \"/a\", subscriber_id = 2");
     add(r - 0.5, 200, 201, "relay", "agnocast_create_callable",
         "callable = 0x40, entry_id = " + a + ", pid_ciid = 1");
     add(r, 200, 201, "relay", "agnocast_callable_start", "callable = 0x40");
-    add(r + 4, 200, 201, "relay", "agnocast_publish", "publisher_handle = 0x50, entry_id = " + b);
+    add(r + 4, 200, 201, "relay", "agnocast_publish",
+        "publisher_handle = 0x50, entry_id = " + b + ", topic_name = \"/b\", publisher_id = 1");
     add(r + 5, 200, 201, "relay", "agnocast_callable_end", "callable = 0x40");
     // The listener starts 100 µs after the relay's publish.
     add(r + 104, 300, 300, "listener", "agnocast_take",
-        "subscription_handle = 0x60, message = 0x8000, entry_id = " + b);
+        "subscription_handle = 0x60, message = 0x8000, entry_id = " + b +
+            ", topic_name = \"/b\", subscriber_id = 2");
     add(r + 104.5, 300, 300, "listener", "agnocast_callable_start", "callable = 0x60");
     add(r + 110, 300, 300, "listener", "agnocast_callable_end", "callable = 0x60");
   }
@@ -169,6 +173,33 @@ TEST(ChromeTrace, SlicesPerCallbackAndAFlowFromEachPublishToItsCallback) {
     if (meta["name"] == "process_name") names.insert(meta["args"]["name"].get<std::string>());
   }
   EXPECT_EQ(names, (std::set<std::string>{"talker", "relay", "listener", "agnocast entries"}));
+}
+
+TEST(ChromeTrace, ProcessesStartedBeforeTheRecordingAreFollowedByTopicAndNamedByTheKernel) {
+  // No init events: the session began after the endpoints were made.
+  std::string text;
+  std::istringstream lines(pipeline_text());
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("_init:") == std::string::npos) text += line + "\n";
+  }
+  RecordedTrace recorded;
+  recorded.library = parse_lttng_text(text);
+  recorded.subscriber_nodes[{"/a", 2}] = "relay";
+  recorded.subscriber_nodes[{"/b", 2}] = "listener";
+  recorded.publisher_nodes[{"/a", 1}] = "talker";
+  const json trace = chrome_trace(recorded);
+  EXPECT_EQ(trace["otherData"]["flows"], 4);
+  const json callbacks = events_of(trace, "X", "callback");
+  ASSERT_EQ(callbacks.size(), 6u);
+  EXPECT_EQ(callbacks[0]["name"], "callback");  // the timer: nothing names it
+  EXPECT_EQ(callbacks[0]["args"]["callable"], "0x30");
+  EXPECT_EQ(callbacks[1]["name"], "callback /a");
+  EXPECT_EQ(callbacks[1]["args"]["node"], "relay");
+  EXPECT_EQ(callbacks[2]["args"]["node"], "listener");
+  const json publishes = events_of(trace, "X", "publish");
+  ASSERT_EQ(publishes.size(), 4u);
+  EXPECT_EQ(publishes[0]["args"]["node"], "talker");
+  EXPECT_EQ(publishes[1]["args"]["node"], "");  // /b's publisher is not in the kernel's map
 }
 
 TEST(ChromeTrace, TopicsFilterLeavesOtherTopicsOut) {

@@ -115,7 +115,8 @@ void PublisherCore::publish(void* message, std::size_t bytes, const ServiceRoute
       }
     }
     // Before the wake-ups: a subscriber's take never precedes its publish.
-    AGNOCAST_TRACE(agnocast_publish, this, static_cast<std::int64_t>(result.entry_id));
+    AGNOCAST_TRACE(agnocast_publish, this, static_cast<std::int64_t>(result.entry_id),
+                   state.topic.c_str(), state.endpoint.id);
     for (std::uint32_t i = 0; i < result.wake_count; ++i) {
       if (!state.senders.notify(state.wake_ids[i])) {
         state.runtime.kernel().notify_failed(state.endpoint, state.wake_ids[i]);

@@ -434,7 +434,8 @@ std::size_t SubscriptionBase::handle_wakeup() {
         const MessageInfo info = info_of(runtime, entries[i]);
         state.delays->record(info.publish_time);
         const auto* message = reinterpret_cast<const void*>(entries[i].addr);
-        AGNOCAST_TRACE(agnocast_take, this, message, static_cast<std::int64_t>(info.entry_id));
+        AGNOCAST_TRACE(agnocast_take, this, message, static_cast<std::int64_t>(info.entry_id),
+                       state.topic.c_str(), id());
         AGNOCAST_TRACE(agnocast_create_callable, this, static_cast<std::int64_t>(info.entry_id),
                        callable_id(id()));
         const TracedCallable callable(this);
@@ -500,7 +501,7 @@ bool PollingCore::take_newer() {
   grants.unlock();
   if (!reference) return false;
   AGNOCAST_TRACE(agnocast_take, this, reinterpret_cast<const void*>(taken.entry.addr),
-                 static_cast<std::int64_t>(taken.entry.entry_id));
+                 static_cast<std::int64_t>(taken.entry.entry_id), state_->topic.c_str(), id());
   if (state_->latest.reference) release(state_->latest.reference);
   state_->latest = TakenEntry{reinterpret_cast<const void*>(taken.entry.addr), reference};
   return true;

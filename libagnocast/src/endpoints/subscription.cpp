@@ -340,7 +340,8 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
   AGNOCAST_TRACE(agnocast_subscription_init, this, state_->node.get(), this, group().get(),
-                 type.name.data(), state_->topic.c_str(), qos.depth(), callable_id(id()), id());
+                 std::string(type.name).c_str(), state_->topic.c_str(), qos.depth(),
+                 callable_id(id()), id());
   // A service's carriers are not topics anyone asks the delay of.
   state_->delays = use == TopicUse::application
                        ? std::make_unique<DelayRecorder>(state_->topic, state_->endpoint->id().id)
@@ -472,7 +473,8 @@ PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
   AGNOCAST_TRACE(agnocast_subscription_init, this, state_->node.get(), nullptr, nullptr,
-                 type.name.data(), state_->topic.c_str(), qos.depth(), callable_id(id()), id());
+                 std::string(type.name).c_str(), state_->topic.c_str(), qos.depth(),
+                 callable_id(id()), id());
 }
 
 PollingCore::~PollingCore() {

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -379,8 +380,9 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
     }
     trace.library = parse_lttng_text(text);
   }
-  // Processes that lived throughout and sent nothing carry no probes: they
-  // started while no session daemon listened (libagnocast/README.md, "Tracing").
+  // Processes that lived throughout and sent nothing were idle, or carry no
+  // probes: they started while no session daemon listened
+  // (libagnocast/README.md, "Tracing").
   std::set<int> silent = running;
   for (const TraceEvent& event : trace.library) silent.erase(event.pid);
   const std::set<int> alive = agnocast_pids(source);
@@ -389,7 +391,11 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
   {
     std::ofstream file(output, std::ios::trunc);
     file << chrome.dump() << '\n';
-    if (!file.flush()) throw CliError("cannot write " + output + ": " + std::strerror(errno));
+    if (!file.flush()) {
+      const std::string why = std::strerror(errno);
+      std::remove(output.c_str());  // no half a trace left behind
+      throw CliError("cannot write " + output + ": " + why);
+    }
   }
   const nlohmann::json& other = chrome["otherData"];
   nlohmann::json summary = {
@@ -410,12 +416,11 @@ int trace_record(InspectionSource& source, const TraceRecordOptions& options, st
     if (!kernel_problem.empty()) out << "kernel events left out: " << kernel_problem << '\n';
     if (!counts_problem.empty()) out << "entry counts left out: " << counts_problem << '\n';
     if (!silent.empty()) {
-      out << silent.size()
-          << " agnocast processes sent no events, having started while no LTTng session daemon "
-             "ran (pids";
+      out << silent.size() << " agnocast processes sent no events (pids";
       for (const int pid : silent) out << ' ' << pid;
-      out << "): start lttng-sessiond before them (systemctl start lttng-sessiond), or start "
-             "them with AGNOCAST_LTTNG=1\n";
+      out << "): idle, or started while no LTTng session daemon ran; for those, start "
+             "lttng-sessiond before them (systemctl start lttng-sessiond), or start them with "
+             "AGNOCAST_LTTNG=1\n";
     }
     if (trace.library.empty()) {
       out << "no library events: no agnocast process ran, or libagnocast was built with "

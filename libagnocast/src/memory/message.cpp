@@ -11,6 +11,7 @@
 #include "agnocast/heap_scope.hpp"
 #include "kernel/runtime.hpp"
 #include "memory/tlsf.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -34,6 +35,7 @@ void* allocate_message(std::size_t size, std::size_t align, void (*destroy)(void
   const std::uint64_t& thread_counter = pool_bytes_allocated_by_this_thread();
   *header_of(message) =
       MessageHeader{nullptr, destroy, block, &thread_counter, thread_counter, 0, 0, ServiceTag{}};
+  AGNOCAST_TRACE(agnocast_loan, message, static_cast<std::uint64_t>(size));
   return message;
 }
 

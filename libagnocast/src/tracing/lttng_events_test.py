@@ -169,6 +169,10 @@ def verify(events):
         check(sorted(entry for t, entry in takes if t == topic) == entries,
               f"on {topic} the takes are not the publishes")
     check(relayed == MESSAGES, f"{relayed} publishes inside the relay's callback")
+    # Every message published was loaned first, on the thread that published it.
+    loans = [f for _, n, f in events if n == "agnocast_loan"]
+    check(len(loans) == 2 * MESSAGES and all(f["size"] == 8 and f["message"] for f in loans),
+          f"{len(loans)} loans of 8 bytes, not {2 * MESSAGES}")
     check(timer_calls >= MESSAGES, f"{timer_calls} timer callbacks")
     check(by_name["agnocast_executor_wait"] > 0 and
           abs(by_name["agnocast_executor_wait"] - by_name["agnocast_executor_wake"]) <= 1,

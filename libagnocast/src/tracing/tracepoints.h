@@ -117,6 +117,12 @@ LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_callable_end,
   LTTNG_UST_TP_FIELDS(
     lttng_ust_field_integer_hex(uintptr_t, callable, (uintptr_t)callable_arg)))
 
+LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_loan,
+  LTTNG_UST_TP_ARGS(const void *, message_arg, uint64_t, size_arg),
+  LTTNG_UST_TP_FIELDS(
+    lttng_ust_field_integer_hex(uintptr_t, message, (uintptr_t)message_arg)
+    lttng_ust_field_integer(uint64_t, size, size_arg)))
+
 LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_executor_wait,
   LTTNG_UST_TP_ARGS(const void *, executor_addr_arg, int32_t, timeout_ms_arg),
   LTTNG_UST_TP_FIELDS(

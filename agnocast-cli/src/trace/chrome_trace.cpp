@@ -1,10 +1,12 @@
 #include "trace/chrome_trace.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
-#include <set>
-#include <tuple>
+#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace agnocast::cli {
 namespace {
@@ -19,6 +21,7 @@ double micros(std::int64_t ns) { return static_cast<double>(ns) / 1e3; }
 // An object of the library, by process and address.
 using Handle = std::pair<int, std::int64_t>;
 
+// What a publisher, subscription or timer is (for a timer, `topic` holds its name).
 struct Endpoint {
   std::string topic;
   std::string node;

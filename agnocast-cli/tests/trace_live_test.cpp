@@ -232,7 +232,9 @@ TEST_F(TraceLive, EveryMessageOfAPipelineFlowsToItsCallbacksAndTheReportAgreesWi
   const double from_delay = row["p50_us"], from_trace = consumer_row["p50_us"];
   std::cout << "p50 publish -> callback start: topic delay " << from_delay << " us, trace "
             << from_trace << " us\n";
-  EXPECT_LE(std::fabs(from_delay - from_trace), 0.25 * from_delay + 50)
+  // Under TCG that system call takes up to a few hundred microseconds: the
+  // trace's figure runs that much shorter.
+  EXPECT_LE(std::fabs(from_delay - from_trace), 0.3 * from_delay + 100)
       << "topic delay and the trace disagree";
   stop(session_daemon);
   expect_nothing_left();

@@ -10,6 +10,7 @@
 #include "agnocast/heap_scope.hpp"
 #include "heaphook_interface.h"
 #include "kernel/runtime.hpp"
+#include "tracing/trace.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -63,11 +64,15 @@ void* enter_heap_scope() {
   const agnocast_heaphook_interface* found = hook();
   if (!found) return nullptr;
   Runtime::get();  // the pool exists (and the hook knows it) before anything is routed
-  return found->enter_scope();
+  void* token = found->enter_scope();
+  AGNOCAST_TRACE(agnocast_heap_scope_enter, token);
+  return token;
 }
 
 void leave_heap_scope(void* token) noexcept {
-  if (token) hook()->leave_scope(token);
+  if (!token) return;
+  AGNOCAST_TRACE(agnocast_heap_scope_exit, token);
+  hook()->leave_scope(token);
 }
 
 void require_heap_hook(std::string_view type_name) {

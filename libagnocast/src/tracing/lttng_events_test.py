@@ -5,8 +5,11 @@ Runs agnocast_trace_workload (a timer publishing on topic _a, a relay
 publishing each message again on _b, a sink) in an LTTng session, reads the
 trace with babeltrace2 and checks that every event has its fields and that
 each publish can be followed, by entry id, to the take and the callback it
-caused.  Starts a session daemon when none runs, and stops it again.
-usage: lttng_events_test.py TRACE_WORKLOAD
+caused; and, in the same session, one test of the allocation hook, whose
+heap scopes must each be entered and left once.  Starts a session daemon
+when none runs, and stops it again.
+usage: lttng_events_test.py TRACE_WORKLOAD [HEAPHOOK_TESTS]
+(a sanitized build has no HEAPHOOK_TESTS: the sanitizer's malloc comes first)
 """
 import collections
 import os
@@ -58,7 +61,10 @@ def parse(text):
     return events
 
 
-def record(workload, output):
+HEAP_TEST = "HeapHookTest.TheScopeEndsAtPublishAndWhenALoanIsDropped"
+
+
+def record(workload, heaphook_tests, output):
     session = f"agnocast_events_{os.getpid()}"
     lttng("create", session, f"--output={output}")
     try:
@@ -68,12 +74,42 @@ def record(workload, output):
         run = subprocess.run([workload, str(MESSAGES)], capture_output=True, text=True, timeout=60)
         print(run.stdout + run.stderr, end="")
         check(run.returncode == 0, f"the workload failed (exit {run.returncode})")
+        if heaphook_tests:
+            hook = subprocess.run([heaphook_tests, f"--gtest_filter={HEAP_TEST}"],
+                                  capture_output=True, text=True, timeout=60)
+            check(hook.returncode == 0, f"{HEAP_TEST} failed: {hook.stdout}{hook.stderr}")
         lttng("stop", session)
     finally:
         subprocess.run(["lttng", "destroy", session], capture_output=True, timeout=60)
 
 
+def verify_heap_scopes(events):
+    """The hook's test process: every scope entered is left once, on its token."""
+    pids = {f["vpid"] for _, n, f in events if n == "agnocast_heap_scope_enter"}
+    if not check(len(pids) == 1, f"heap scopes entered by {len(pids)} processes, not 1"):
+        return
+    pid = pids.pop()
+    open_scopes = collections.Counter()
+    entered = 0
+    for _, name, f in events:
+        if f["vpid"] != pid:
+            continue
+        if name == "agnocast_heap_scope_enter":
+            check(f["scope"] != 0, "a heap scope without its token")
+            open_scopes[f["scope"]] += 1
+            entered += 1
+        elif name == "agnocast_heap_scope_exit":
+            check(open_scopes[f["scope"]] > 0, f"heap scope {f['scope']:#x} left, never entered")
+            open_scopes[f["scope"]] -= 1
+    check(entered >= 2, f"{entered} heap scopes entered, not 2 at least (publish, drop)")
+    check(not +open_scopes, f"heap scopes never left: {dict(+open_scopes)}")
+    print(f"heap scopes: {entered} entered and left")
+
+
 def verify(events):
+    # The workload's process alone; the hook's test is verify_heap_scopes()'.
+    scoped = {f["vpid"] for _, n, f in events if n == "agnocast_heap_scope_enter"}
+    events = [e for e in events if e[2].get("vpid") not in scoped]
     by_name = collections.Counter(name for _, name, _ in events)
     print("events:", ", ".join(f"{name} {count}" for name, count in sorted(by_name.items())))
     for time_, name, fields in events:
@@ -183,18 +219,22 @@ def verify(events):
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
+    heaphook_tests = sys.argv[2] if len(sys.argv) == 3 else None
     for tool in ("lttng", "lttng-sessiond", "babeltrace2"):
         if not shutil.which(tool):
             sys.exit(f"FAIL: {tool} is missing: scripts/install-deps testbed installs it")
     before = session_daemons()
     output = tempfile.mkdtemp(prefix="agnocast-lttng-")
     try:
-        record(sys.argv[1], output)
+        record(sys.argv[1], heaphook_tests, output)
         text = subprocess.run(["babeltrace2", "--clock-seconds", "--no-delta", output],
                               capture_output=True, text=True, timeout=120, check=True).stdout
-        verify(parse(text))
+        events = parse(text)
+        verify(events)
+        if heaphook_tests:
+            verify_heap_scopes(events)
     finally:
         shutil.rmtree(output, ignore_errors=True)
         for pid in session_daemons() - before:

@@ -123,6 +123,16 @@ LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_loan,
     lttng_ust_field_integer_hex(uintptr_t, message, (uintptr_t)message_arg)
     lttng_ust_field_integer(uint64_t, size, size_arg)))
 
+LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_heap_scope_enter,
+  LTTNG_UST_TP_ARGS(const void *, scope_arg),
+  LTTNG_UST_TP_FIELDS(
+    lttng_ust_field_integer_hex(uintptr_t, scope, (uintptr_t)scope_arg)))
+
+LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_heap_scope_exit,
+  LTTNG_UST_TP_ARGS(const void *, scope_arg),
+  LTTNG_UST_TP_FIELDS(
+    lttng_ust_field_integer_hex(uintptr_t, scope, (uintptr_t)scope_arg)))
+
 LTTNG_UST_TRACEPOINT_EVENT(agnocast, agnocast_executor_wait,
   LTTNG_UST_TP_ARGS(const void *, executor_addr_arg, int32_t, timeout_ms_arg),
   LTTNG_UST_TP_FIELDS(

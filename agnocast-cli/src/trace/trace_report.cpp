@@ -64,9 +64,16 @@ std::string format_us(const json& value) {
 }  // namespace
 
 json trace_report_json(const json& trace, const std::vector<std::string>& path) {
-  if (!trace.is_object() || !trace.contains("traceEvents") || !trace["traceEvents"].is_array() ||
-      !trace.contains("otherData") || !trace["otherData"].is_object() ||
-      trace["otherData"].value("agnocast_trace", 0) != chrome_trace_format) {
+  const auto marked = [&] {
+    if (!trace.is_object() || !trace.contains("traceEvents") || !trace.contains("otherData")) {
+      return false;
+    }
+    const json& other = trace["otherData"];
+    return trace["traceEvents"].is_array() && other.is_object() &&
+           other.contains("agnocast_trace") && other["agnocast_trace"].is_number_integer() &&
+           other["agnocast_trace"] == chrome_trace_format;
+  };
+  if (!marked()) {
     throw InputError(
         "not a trace agnocast-cli trace record wrote (no traceEvents with otherData.agnocast_trace "
         "= 1): record one with agnocast-cli trace record -o FILE");

@@ -251,6 +251,13 @@ TEST(TraceReport, APathNoMessageFollowsIsCountedIncomplete) {
 TEST(TraceReport, RefusesWhatIsNotATraceRecordWrote) {
   EXPECT_THROW(trace_report_json(json::array(), {}), InputError);
   EXPECT_THROW(trace_report_json(json{{"traceEvents", json::array()}}, {}), InputError);
+  EXPECT_THROW(
+      trace_report_json(
+          json{{"traceEvents", json::array()}, {"otherData", {{"agnocast_trace", "1"}}}}, {}),
+      InputError);
+  EXPECT_THROW(
+      trace_report_json(json{{"traceEvents", {1, 2}}, {"otherData", {{"agnocast_trace", 1}}}}, {}),
+      InputError);
   const json foreign = {{"traceEvents", {{{"ph", "f"}, {"cat", "flow"}, {"id", 7}}}},
                         {"otherData", {{"agnocast_trace", 1}}}};
   EXPECT_NO_THROW(trace_report_json(foreign, {}));  // a finish without its start is skipped

@@ -38,21 +38,21 @@ bool has_application_socket(const std::string& folder) {
 
 bool session_daemon_listening() {
   if (has_application_socket("/var/run/lttng")) return true;
-  const char* home = std::getenv("LTTNG_HOME");
-  if (!home) home = std::getenv("HOME");
+  const char* home = ::secure_getenv("LTTNG_HOME");
+  if (!home) home = ::secure_getenv("HOME");
   return home && has_application_socket(std::string(home) + "/.lttng");
 }
 
 void load_probes() {
-  const char* asked = std::getenv("AGNOCAST_LTTNG");
+  // secure_getenv: a set-user-ID program takes no say from its caller.
+  const char* asked = ::secure_getenv("AGNOCAST_LTTNG");
   const std::string_view wanted = asked ? asked : "";
   if (wanted == "0" || (wanted != "1" && !session_daemon_listening())) return;
   std::string path = AGNOCAST_LTTNG_PROVIDER;
   Dl_info self{};
   if (::dladdr(reinterpret_cast<void*>(&load_probes), &self) && self.dli_fname) {
     const std::string library = self.dli_fname;
-    const std::string beside =
-        library.substr(0, library.rfind('/') + 1) + AGNOCAST_LTTNG_PROVIDER;
+    const std::string beside = library.substr(0, library.rfind('/') + 1) + AGNOCAST_LTTNG_PROVIDER;
     if (library.find('/') != std::string::npos && ::access(beside.c_str(), R_OK) == 0) {
       path = beside;
     }

@@ -6,7 +6,8 @@ publishing each message again on _b, a sink) in an LTTng session, reads the
 trace with babeltrace2 and checks that every event has its fields and that
 each publish can be followed, by entry id, to the take and the callback it
 caused; and, in the same session, one test of the allocation hook, whose
-heap scopes must each be entered and left once.  Starts a session daemon
+heap scopes must each be entered and left once; and the workload again with
+AGNOCAST_LTTNG=0, which must send nothing.  Starts a session daemon
 when none runs, and stops it again.
 usage: lttng_events_test.py TRACE_WORKLOAD [HEAPHOOK_TESTS]
 (a sanitized build has no HEAPHOOK_TESTS: the sanitizer's malloc comes first)
@@ -78,7 +79,12 @@ def record(workload, heaphook_tests, output):
             hook = subprocess.run([heaphook_tests, f"--gtest_filter={HEAP_TEST}"],
                                   capture_output=True, text=True, timeout=60)
             check(hook.returncode == 0, f"{HEAP_TEST} failed: {hook.stdout}{hook.stderr}")
+        # Asked not to load the probes, though a session daemon listens.
+        quiet = subprocess.Popen([workload, "5"], env={**os.environ, "AGNOCAST_LTTNG": "0"},
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        check(quiet.wait(timeout=60) == 0, "the workload with AGNOCAST_LTTNG=0 failed")
         lttng("stop", session)
+        return quiet.pid
     finally:
         subprocess.run(["lttng", "destroy", session], capture_output=True, timeout=60)
 
@@ -228,10 +234,13 @@ def main():
     before = session_daemons()
     output = tempfile.mkdtemp(prefix="agnocast-lttng-")
     try:
-        record(sys.argv[1], heaphook_tests, output)
+        opted_out = record(sys.argv[1], heaphook_tests, output)
         text = subprocess.run(["babeltrace2", "--clock-seconds", "--no-delta", output],
                               capture_output=True, text=True, timeout=120, check=True).stdout
         events = parse(text)
+        sent = sum(1 for _, _, f in events if f.get("vpid") == opted_out)
+        check(sent == 0, f"the workload with AGNOCAST_LTTNG=0 sent {sent} events")
+        events = [e for e in events if e[2].get("vpid") != opted_out]
         verify(events)
         if heaphook_tests:
             verify_heap_scopes(events)

@@ -90,6 +90,18 @@ bool running(std::initializer_list<std::string> names) {
   return false;
 }
 
+// Waits for `trace record` (stem.out, stem.err) to end, which it must with
+// exit 0, and returns its summary; `recorder` becomes -1.
+json finished_recording(pid_t& recorder, const std::string& stem) {
+  const int code = exit_within(recorder, 120s);
+  recorder = -1;
+  EXPECT_EQ(code, 0) << slurp(stem + ".err");
+  if (code != 0) return nullptr;
+  const json summary = json::parse(slurp(stem + ".out"));
+  std::cout << "trace record: " << summary.dump() << "\n";
+  return summary;
+}
+
 // The system's session daemon, as `systemctl start lttng-sessiond` runs it.
 pid_t start_session_daemon() {
   const pid_t daemon = spawn({"lttng-sessiond", "--no-kernel"}, "sessiond.log");
@@ -173,13 +185,10 @@ TEST_F(TraceLive, EveryMessageOfAPipelineFlowsToItsCallbacksAndTheReportAgreesWi
   // The window outlasts the driver: every scan has reached the consumer by its end.
   EXPECT_EQ(exit_within(delay, 120s), 0) << slurp("delay.err");
   ::kill(recorder, SIGINT);
-  const int recorded = exit_within(recorder, 120s);
-  recorder = -1;
-  ASSERT_EQ(recorded, 0) << slurp("record.err");
+  const json summary = finished_recording(recorder, "record");
+  ASSERT_FALSE(summary.is_null());
   stop(filter);
 
-  const json summary = json::parse(slurp("record.out"));
-  std::cout << "trace record: " << summary.dump() << "\n";
   EXPECT_EQ(summary["kernel"], true);
   EXPECT_EQ(summary["counts"], true);
   EXPECT_GE(summary["flows"].get<int>(), 2 * scans);
@@ -262,12 +271,9 @@ TEST_F(TraceLive, ProcessesKilledWhileRecordingLeaveAValidTrace) {
   ::kill(listener, SIGKILL);  // mid-callback, perhaps
   ::waitpid(listener, nullptr, 0);
   listener = -1;
-  const int recorded = exit_within(recorder, 120s);
-  recorder = -1;
-  ASSERT_EQ(recorded, 0) << slurp("dying.err");
+  const json summary = finished_recording(recorder, "dying");
+  ASSERT_FALSE(summary.is_null());
   stop(talker);
-  const json summary = json::parse(slurp("dying.out"));
-  std::cout << "trace record: " << summary.dump() << "\n";
   EXPECT_GT(summary["flows"].get<int>(), 0);
   EXPECT_EQ(summary["silent_pids"], json::array({early}));
   const auto report = cli("trace report dying.json --json", "dying-report");

@@ -7,21 +7,16 @@
 #include "agnocast/naming.hpp"
 #include "agnocast/schema_definition.hpp"
 #include "commands.hpp"
+#include "table.hpp"
 
 namespace agnocast::cli {
 namespace {
 
 // Polling subscribers are never woken: look this often when nothing is waiting.
-constexpr double poll_interval_s = 0.01;
+constexpr double echo_poll_interval_s = 0.01;
 
 std::string plural(std::size_t n, const char* what) {
   return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
-}
-
-std::string seconds_text(double seconds) {
-  std::ostringstream text;
-  text << seconds;
-  return text.str();
 }
 
 }  // namespace
@@ -74,7 +69,7 @@ int topic_echo(InspectionSource& source, const EchoOptions& options, std::ostrea
                      "; `agnocast-cli topic info " + options.topic +
                      "` shows whether anyone publishes");
     }
-    source.sleep_seconds(poll_interval_s);
+    source.sleep_seconds(echo_poll_interval_s);
   }
   return exit_success;
 }

@@ -13,18 +13,13 @@
 #include "agnocast/naming.hpp"
 #include "agnocast/node.hpp"
 #include "agnocast/schema_client.hpp"
+#include "table.hpp"
 
 namespace agnocast::cli {
 namespace {
 
 // Nothing wakes a caller when a service appears: look this often.
-constexpr double poll_interval_s = 0.02;
-
-std::string seconds_text(double seconds) {
-  std::ostringstream text;
-  text << seconds;
-  return text.str();
-}
+constexpr double service_poll_interval_s = 0.02;
 
 std::chrono::nanoseconds nanoseconds_of(double seconds) {
   return std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(seconds, 0.0) * 1e9));
@@ -90,7 +85,7 @@ int service_call(ServiceBackend& backend, const ServiceCallOptions& options, std
   std::optional<ServiceTypes> types = backend.find_types(options.service);
   while (!types) {
     if (left() <= 0) throw no_server(options);
-    backend.sleep_seconds(std::min(poll_interval_s, left()));
+    backend.sleep_seconds(std::min(service_poll_interval_s, left()));
     types = backend.find_types(options.service);
   }
   std::vector<std::uint8_t> request;

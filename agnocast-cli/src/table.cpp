@@ -1,6 +1,7 @@
 #include "table.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <stdexcept>
 
 namespace agnocast::cli {
@@ -64,6 +65,12 @@ std::string key_value_lines(const nlohmann::json& object, const std::vector<std:
     text += key + std::string(width - key.size() + 2, ' ') + value + '\n';
   }
   return text;
+}
+
+std::string seconds_text(double seconds) {
+  std::ostringstream text;
+  text << seconds;
+  return text.str();
 }
 
 }  // namespace agnocast::cli

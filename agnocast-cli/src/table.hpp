@@ -33,4 +33,7 @@ std::string cell(const nlohmann::json& value);
 // "key  value" lines for one flat object, in the given key order.
 std::string key_value_lines(const nlohmann::json& object, const std::vector<std::string>& keys);
 
+// A number of seconds as a message shows it: 2, 0.5, 1e-05.
+std::string seconds_text(double seconds);
+
 }  // namespace agnocast::cli

@@ -21,7 +21,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double sample_interval_s = 0.1;
+constexpr double delay_sample_interval_s = 0.1;
 
 // The nearest-rank percentile of sorted values.
 std::int64_t percentile(const std::vector<std::int64_t>& sorted, double fraction) {
@@ -54,7 +54,7 @@ class DelayMeter {
     }
     while (sampled_at_ < end) {
       if (source_.stop_requested()) return std::nullopt;
-      source_.sleep_seconds(std::min(sample_interval_s, end - sampled_at_));
+      source_.sleep_seconds(std::min(delay_sample_interval_s, end - sampled_at_));
       sample(false);
       sampled_at_ = source_.now_seconds();
     }

@@ -17,7 +17,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double sample_interval_s = 0.001;
+constexpr double hz_sample_interval_s = 0.001;
 
 struct Counters {
   std::uint64_t messages = 0;
@@ -64,7 +64,7 @@ class HzMeter {
     std::vector<double> periods;
     while (sampled_at_ < end) {
       if (source_.stop_requested()) return std::nullopt;
-      source_.sleep_seconds(std::min(sample_interval_s, end - sampled_at_));
+      source_.sleep_seconds(std::min(hz_sample_interval_s, end - sampled_at_));
       const auto now_counters = sample(source_, topic_);
       const double now = source_.now_seconds();
       const Counters got = delta(counters_, now_counters);

@@ -15,4 +15,7 @@ std::string cpp_value(const FieldType& type, std::string_view text);
 // A C++ string literal holding exactly `text`.
 std::string cpp_string_literal(std::string_view text);
 
+// `text` without the white space at either end.
+std::string_view trim(std::string_view text);
+
 }  // namespace msggen

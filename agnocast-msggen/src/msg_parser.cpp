@@ -24,16 +24,6 @@ const std::map<std::string_view, BaseType>& primitive_names() {
   return names;
 }
 
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) {
-    text.remove_prefix(1);
-  }
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) {
-    text.remove_suffix(1);
-  }
-  return text;
-}
-
 bool is_lower_identifier(std::string_view name) {
   if (name.empty() || !std::islower(static_cast<unsigned char>(name.front()))) return false;
   for (const char c : name) {

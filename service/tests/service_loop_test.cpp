@@ -17,6 +17,7 @@
 #include "agnocast/status.hpp"
 #include "agnocast/version.hpp"
 #include "fake_notify_socket.hpp"
+#include "readable.hpp"
 
 namespace agnocast_service {
 namespace {
@@ -48,11 +49,6 @@ class ServiceLoopTest : public ::testing::Test {
   const std::string status_path_ = (directory_ / "x.json").string();
   const std::string lock_path_ = (directory_ / "x.lock").string();
 };
-
-bool readable(int fd, std::chrono::milliseconds wait) {
-  pollfd entry{fd, POLLIN, 0};
-  return ::poll(&entry, 1, static_cast<int>(wait.count())) == 1;
-}
 
 // Dispatches until it returns false or `wait` has passed; its last result.
 bool dispatch_until_stopping(ServiceLoop& service, std::chrono::milliseconds wait) {

@@ -10,16 +10,12 @@
 #include "agnocast_service/timer.hpp"
 #include "agnocast_service/watchdog.hpp"
 #include "fake_notify_socket.hpp"
+#include "readable.hpp"
 
 namespace agnocast_service {
 namespace {
 
 using namespace std::chrono_literals;
-
-bool readable(int fd, std::chrono::milliseconds wait) {
-  pollfd entry{fd, POLLIN, 0};
-  return ::poll(&entry, 1, static_cast<int>(wait.count())) == 1;
-}
 
 TEST(Signals, BlockedSignalsAreReadFromTheDescriptor) {
   const sigset_t usr = signal_set({SIGUSR1, SIGUSR2});

@@ -11,6 +11,7 @@
 
 #include "agnocast/errors.hpp"
 #include "agnocast/naming.hpp"
+#include "kernel/fake_runtime.hpp"
 
 namespace agnocast::detail {
 namespace {
@@ -18,11 +19,6 @@ namespace {
 // Unique per test run so parallel runs and leftovers never collide.
 std::string test_topic(const char* what) {
   return "/agnocast_unit/" + std::string(what) + "/" + std::to_string(::getpid());
-}
-
-bool readable(int fd) {
-  pollfd entry{fd, POLLIN, 0};
-  return ::poll(&entry, 1, 0) == 1;
 }
 
 long pending(int fd) {

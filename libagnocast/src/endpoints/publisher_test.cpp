@@ -18,12 +18,6 @@ namespace {
 
 using PublisherTest = FakeRuntimeTest;
 
-void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
-  auto message = publisher.borrow_loaned_message();
-  message->seq = seq;
-  publisher.publish(std::move(message));
-}
-
 TEST_F(PublisherTest, GrowsItsWakeSlotsUntilEverySubscriberIsWoken) {
   Node node{"growth"};
   const std::string name = topic("growth");

@@ -45,17 +45,6 @@ namespace {
 
 using SubscriptionTest = FakeRuntimeTest;
 
-bool readable(int fd) {
-  pollfd entry{fd, POLLIN, 0};
-  return ::poll(&entry, 1, 0) == 1;
-}
-
-void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
-  auto message = publisher.borrow_loaned_message();
-  message->seq = seq;
-  publisher.publish(std::move(message));
-}
-
 TEST_F(SubscriptionTest, OneWakeUpDeliversEveryWaitingMessageOldestFirst) {
   Node node{"drain"};
   const std::string name = topic("drain");

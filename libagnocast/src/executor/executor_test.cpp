@@ -20,12 +20,6 @@ namespace {
 using namespace std::chrono_literals;
 using ExecutorTest = FakeRuntimeTest;
 
-void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
-  auto message = publisher.borrow_loaned_message();
-  message->seq = seq;
-  publisher.publish(std::move(message));
-}
-
 template <class Condition>
 bool eventually(Condition condition) {
   const auto deadline = std::chrono::steady_clock::now() + 10s;

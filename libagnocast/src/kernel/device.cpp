@@ -163,7 +163,7 @@ std::string add_endpoint_advice(int err, const EndpointRequest& request, std::st
   }
 }
 
-std::string hex(std::uint64_t value) {
+std::string layout_hash_hex(std::uint64_t value) {
   char text[19];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
   return text;
@@ -176,14 +176,15 @@ std::string hex(std::uint64_t value) {
     TopicInfo info;
     try {
       if (device.topic_info(request.topic, info)) {
-        topic_type = "'" + info.type_name + "' (layout hash " + hex(info.type_hash) + ")";
+        topic_type =
+            "'" + info.type_name + "' (layout hash " + layout_hash_hex(info.type_hash) + ")";
       }
     } catch (const DeviceError&) {
       // The message below still says what this endpoint wanted.
     }
     throw TypeMismatch("agnocast: " + std::string(command) + " failed: topic " + request.topic +
                        " carries " + topic_type + ", but this " + std::string(kind) + " uses '" +
-                       request.type_name + "' (layout hash " + hex(request.type_hash) +
+                       request.type_name + "' (layout hash " + layout_hash_hex(request.type_hash) +
                        "): use the topic's message type, or rebuild both programs against the "
                        "same definition of it");
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <cstddef>
@@ -10,7 +11,9 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <utility>
 
+#include "agnocast/publisher.hpp"
 #include "kernel/fake_kernel.hpp"
 #include "kernel/runtime.hpp"
 
@@ -47,5 +50,18 @@ class FakeRuntimeTest : public ::testing::Test {
   Runtime* runtime_ = nullptr;
   std::byte* region_ = nullptr;
 };
+
+// Publishes one Counted message numbered `seq`.
+inline void publish(Publisher<Counted>& publisher, std::uint64_t seq) {
+  auto message = publisher.borrow_loaned_message();
+  message->seq = seq;
+  publisher.publish(std::move(message));
+}
+
+// Whether `fd` is readable now, without waiting.
+inline bool readable(int fd) {
+  pollfd entry{fd, POLLIN, 0};
+  return ::poll(&entry, 1, 0) == 1;
+}
 
 }  // namespace agnocast::detail

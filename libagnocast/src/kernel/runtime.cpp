@@ -26,7 +26,7 @@ namespace {
 std::atomic<Runtime*> instance{nullptr};
 std::mutex init_mutex;
 
-std::string hex(std::uint64_t value) {
+std::string address_hex(std::uint64_t value) {
   std::ostringstream out;
   out << "0x" << std::hex << value;
   return out.str();
@@ -44,13 +44,13 @@ void map_at(std::uint64_t addr, std::uint64_t size, int prot, int fd, bool repla
   void* mapped = ::mmap(wanted, size, prot, flags, fd, 0);
   if (mapped == MAP_FAILED) {
     const int err = errno;
-    throw Error("agnocast: cannot map " + what + " at " + hex(addr) + " (" + std::to_string(size) +
-                " bytes): " + std::strerror(err) +
+    throw Error("agnocast: cannot map " + what + " at " + address_hex(addr) + " (" +
+                std::to_string(size) + " bytes): " + std::strerror(err) +
                 (err == EEXIST ? "; something else occupies that address range" : ""));
   }
   if (mapped != wanted) {  // kernels before 4.17 treat MAP_FIXED_NOREPLACE as a hint
     ::munmap(mapped, size);
-    throw Error("agnocast: cannot map " + what + " at " + hex(addr) +
+    throw Error("agnocast: cannot map " + what + " at " + address_hex(addr) +
                 ": the kernel placed it elsewhere");
   }
 }

@@ -22,7 +22,6 @@ namespace agnocast {
 namespace {
 
 using topic_watcher_test::Reading;
-using topic_watcher_test::Sample;
 
 // A kernel's topic list the test edits between polls.
 class Topics {
@@ -73,7 +72,7 @@ std::vector<std::string> names(const std::vector<WatchedTopic>& topics) {
 TEST(TopicWatcher, ReportsTopicsAppearingChangingTypeAndGoingAway) {
   Topics topics;
   topics.add<Reading>("/a", 1, 0);
-  topics.add<Sample>("/b", 0, 1);
+  topics.add<topic_watcher_test::Sample>("/b", 0, 1);
   topics.add_raw("/raw");
   TopicWatcher watcher(topics.options());
 
@@ -86,7 +85,7 @@ TEST(TopicWatcher, ReportsTopicsAppearingChangingTypeAndGoingAway) {
   changes = watcher.poll();  // nothing changed, nothing reported
   EXPECT_TRUE(changes.appeared.empty() && changes.gone.empty() && changes.refused.empty());
 
-  topics.add<Sample>("/a", 1, 0);  // another type under the same name
+  topics.add<topic_watcher_test::Sample>("/a", 1, 0);  // another type under the same name
   topics.remove("/b");
   changes = watcher.poll();
   EXPECT_EQ(changes.gone, (std::vector<std::string>{"/a", "/b"}));
@@ -127,7 +126,7 @@ TEST(TopicWatcher, UsesTheTypesOwnTextAndRefusesWhatHasNoDefinitionOnce) {
     return topic;
   };
   TopicWatcher watcher(options);
-  topics.add<Sample>("/broken", 1, 0);
+  topics.add<topic_watcher_test::Sample>("/broken", 1, 0);
   TopicChanges changes = watcher.poll();
   ASSERT_EQ(changes.appeared.size(), 1u);
   EXPECT_EQ(changes.appeared[0].definition, text);
@@ -143,7 +142,7 @@ TEST(TopicWatcher, UsesTheTypesOwnTextAndRefusesWhatHasNoDefinitionOnce) {
 TEST(TopicWatcher, LeavesOutTheTopicsThatCarryServices) {
   Topics topics;
   topics.add<Reading>("/_service_request/calibrate", 1, 1);
-  topics.add<Sample>("/_service_reply/calibrate", 1, 1);
+  topics.add<topic_watcher_test::Sample>("/_service_reply/calibrate", 1, 1);
   topics.add<Reading>("/_service_requests", 1, 0);  // an ordinary topic
   TopicWatcher watcher(topics.options());
   const TopicChanges changes = watcher.poll();

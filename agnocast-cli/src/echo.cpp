@@ -1,6 +1,5 @@
 // agnocast-cli topic echo TOPIC [--count N] [--timeout SEC] [--no-arrays] [--definition] [--json]
 #include <CLI/CLI.hpp>
-#include <sstream>
 
 #include "agnocast/cdr.hpp"
 #include "agnocast/message_render.hpp"

@@ -4,7 +4,6 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
-#include <sstream>
 #include <thread>
 
 #include "agnocast/errors.hpp"

@@ -71,17 +71,3 @@ function(agnocast_add_vm_test)
   set_property(GLOBAL APPEND_STRING PROPERTY AGNOCAST_VM_MANIFEST "${lines}")
   set_property(GLOBAL APPEND PROPERTY AGNOCAST_VM_TEST_NAMES "${arg_NAME}")
 endfunction()
-
-# ctest runs two VMs at a time (scripts/test: ctest -j2), on two lanes: the
-# kernels' suites, one after another, on lane `vm`; the test bed's own VMs,
-# the DKMS builds, the real-systemd tests and the instruction-counted
-# benchmark on lane `vm_side`, at a lower priority, so that the suites'
-# timing-sensitive tests (a wake-up watchdog of 50 ms) keep their speed.
-# A suite alone leaves a core idle most of the time: one test runs at a time.
-#
-#   agnocast_vm_side_lane(TEST...)   puts each test on the second lane; its
-#                                    command must begin with ${AGNOCAST_VM_SIDE_NICE}
-set(AGNOCAST_VM_SIDE_NICE nice -n 10)
-function(agnocast_vm_side_lane)
-  set_tests_properties(${ARGN} PROPERTIES RESOURCE_LOCK vm_side)
-endfunction()

@@ -29,9 +29,12 @@ void validate_node_name(const std::string& name) {
 Node::Node(std::string name) {
   validate_node_name(name);
   state_ = std::make_shared<detail::NodeState>(std::move(name));
-  AGNOCAST_TRACE(agnocast_node_init, state_.get(), state_->name.c_str());
-  AGNOCAST_TRACE(agnocast_callback_group_init, state_->default_group.get(), state_.get(),
-                 "mutually_exclusive");
+  AGNOCAST_TRACE_INIT(state_.get(), [node = state_.get(), name = state_->name.c_str()] {
+    AGNOCAST_TRACE(agnocast_node_init, node, name);
+  });
+  AGNOCAST_TRACE_INIT(state_.get(), [node = state_.get(), group = state_->default_group.get()] {
+    AGNOCAST_TRACE(agnocast_callback_group_init, group, node, "mutually_exclusive");
+  });
 }
 
 Node::~Node() = default;
@@ -40,8 +43,13 @@ const std::string& Node::get_name() const { return state_->name; }
 
 std::shared_ptr<CallbackGroup> Node::create_callback_group(CallbackGroupType type) {
   auto group = std::make_shared<CallbackGroup>(type);
-  AGNOCAST_TRACE(agnocast_callback_group_init, group.get(), state_.get(),
-                 type == CallbackGroupType::Reentrant ? "reentrant" : "mutually_exclusive");
+  // Kept as long as the node: a group is announced while its node lives.
+  AGNOCAST_TRACE_INIT(
+      state_.get(),
+      [node = state_.get(), group = group.get(),
+       kind = type == CallbackGroupType::Reentrant ? "reentrant" : "mutually_exclusive"] {
+        AGNOCAST_TRACE(agnocast_callback_group_init, group, node, kind);
+      });
   return group;
 }
 
@@ -54,13 +62,18 @@ std::shared_ptr<Timer> Node::create_timer(std::chrono::nanoseconds period,
                                           std::shared_ptr<CallbackGroup> group) {
   auto timer = std::make_shared<Timer>(period, std::move(callback),
                                        detail::group_or_default(*state_, std::move(group)));
-  AGNOCAST_TRACE(agnocast_timer_init, timer.get(), state_.get(), timer->group().get(),
-                 static_cast<std::int64_t>(period.count()));
+  AGNOCAST_TRACE_INIT(timer.get(),
+                      [timer = timer.get(), node = state_.get(), group = timer->group().get(),
+                       period = static_cast<std::int64_t>(period.count())] {
+                        AGNOCAST_TRACE(agnocast_timer_init, timer, node, group, period);
+                      });
   detail::register_waitable(*state_, timer);
   return timer;
 }
 
 namespace detail {
+
+NodeState::~NodeState() { AGNOCAST_FORGET_INIT(this); }
 
 void NodeState::add_waitable(const std::shared_ptr<Waitable>& waitable) {
   std::lock_guard lock(mutex);

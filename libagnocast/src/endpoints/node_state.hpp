@@ -17,6 +17,9 @@ struct NodeState {
   explicit NodeState(std::string node_name)
       : name(std::move(node_name)),
         default_group(std::make_shared<CallbackGroup>(CallbackGroupType::MutuallyExclusive)) {}
+  ~NodeState();  // its init events and its groups' are not sent again
+  NodeState(const NodeState&) = delete;
+  NodeState& operator=(const NodeState&) = delete;
 
   void add_waitable(const std::shared_ptr<Waitable>& waitable);
   void remove_waitable(std::uint64_t key);

@@ -43,11 +43,15 @@ PublisherCore::PublisherCore(std::shared_ptr<NodeState> node, std::string_view t
   const EndpointRequest request =
       make_endpoint_request(node->name, topic, qos, EndpointKind::publisher, type, use);
   state_ = std::make_unique<State>(std::move(node), Runtime::get(), request);
-  AGNOCAST_TRACE(agnocast_publisher_init, this, state_->node.get(), state_->topic.c_str(),
-                 qos.depth(), state_->endpoint.id);
+  AGNOCAST_TRACE_INIT(this,
+                      [publisher = this, node = state_->node.get(), topic = state_->topic.c_str(),
+                       depth = qos.depth(), id = state_->endpoint.id] {
+                        AGNOCAST_TRACE(agnocast_publisher_init, publisher, node, topic, depth, id);
+                      });
 }
 
 PublisherCore::~PublisherCore() {
+  AGNOCAST_FORGET_INIT(this);
   // In a fork child the endpoint is the parent's: leave it alone.
   if (Runtime::current() != &state_->runtime) return;
   try {

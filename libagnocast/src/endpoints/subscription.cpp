@@ -339,9 +339,12 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
-  AGNOCAST_TRACE(agnocast_subscription_init, this, state_->node.get(), this, group().get(),
-                 std::string(type.name).c_str(), state_->topic.c_str(), qos.depth(),
-                 callable_id(id()), id());
+  AGNOCAST_TRACE_INIT(this, [subscription = this, node = state_->node.get(), group = group().get(),
+                             symbol = std::string(type.name), topic = state_->topic.c_str(),
+                             depth = qos.depth(), id = id()] {
+    AGNOCAST_TRACE(agnocast_subscription_init, subscription, node, subscription, group,
+                   symbol.c_str(), topic, depth, callable_id(id), id);
+  });
   // A service's carriers are not topics anyone asks the delay of.
   state_->delays = use == TopicUse::application
                        ? std::make_unique<DelayRecorder>(state_->topic, state_->endpoint->id().id)
@@ -357,6 +360,7 @@ SubscriptionBase::SubscriptionBase(std::shared_ptr<NodeState> node, std::string_
 }
 
 SubscriptionBase::~SubscriptionBase() {
+  AGNOCAST_FORGET_INIT(this);
   state_->node->remove_waitable(key());
   state_->node->remove_waitable(state_->release_timer->key());
   state_->endpoint->stop_deferring();  // what waits goes now
@@ -472,12 +476,16 @@ PollingCore::PollingCore(std::shared_ptr<NodeState> node, std::string_view topic
   state_->node = std::move(node);
   state_->topic = request.topic;
   state_->endpoint = std::make_shared<SubscriberEndpoint>(Runtime::get(), request);
-  AGNOCAST_TRACE(agnocast_subscription_init, this, state_->node.get(), nullptr, nullptr,
-                 std::string(type.name).c_str(), state_->topic.c_str(), qos.depth(),
-                 callable_id(id()), id());
+  AGNOCAST_TRACE_INIT(
+      this, [subscription = this, node = state_->node.get(), symbol = std::string(type.name),
+             topic = state_->topic.c_str(), depth = qos.depth(), id = id()] {
+        AGNOCAST_TRACE(agnocast_subscription_init, subscription, node, nullptr, nullptr,
+                       symbol.c_str(), topic, depth, callable_id(id), id);
+      });
 }
 
 PollingCore::~PollingCore() {
+  AGNOCAST_FORGET_INIT(this);
   if (state_->latest.reference) release(state_->latest.reference);
 }
 

@@ -197,6 +197,7 @@ struct Executor::State {
       }
     }
     epoll_event event{};
+    AGNOCAST_REPLAY_INIT();  // for a session that enabled the events since
     AGNOCAST_TRACE(agnocast_executor_wait, this, static_cast<std::int32_t>(timeout_ms));
     const int ready = ::epoll_wait(epoll_fd, &event, 1, timeout_ms);
     AGNOCAST_TRACE(agnocast_executor_wake, this, static_cast<std::int32_t>(ready));
@@ -290,10 +291,13 @@ void Executor::run_in_group(detail::PendingWork work) {
 
 // The executor's events name it by its state, which its waits know.
 Executor::Executor(bool parallel) : state_(std::make_unique<State>(parallel)) {
-  AGNOCAST_TRACE(agnocast_construct_executor, state_.get(),
-                 parallel ? "multi_threaded_executor" : "single_threaded_executor");
+  AGNOCAST_TRACE_INIT(state_.get(),
+                      [executor = state_.get(),
+                       kind = parallel ? "multi_threaded_executor" : "single_threaded_executor"] {
+                        AGNOCAST_TRACE(agnocast_construct_executor, executor, kind);
+                      });
 }
-Executor::~Executor() = default;
+Executor::~Executor() { AGNOCAST_FORGET_INIT(state_.get()); }
 
 void Executor::add_node(Node& node) {
   {

@@ -40,7 +40,10 @@ Timer::Timer(std::chrono::nanoseconds period, std::function<void()> callback,
   arm(true);
 }
 
-Timer::~Timer() { ::close(fd_); }
+Timer::~Timer() {
+  AGNOCAST_FORGET_INIT(this);
+  ::close(fd_);
+}
 
 void Timer::arm(bool on) {
   itimerspec spec{};

@@ -7,8 +7,10 @@ trace with babeltrace2 and checks that every event has its fields and that
 each publish can be followed, by entry id, to the take and the callback it
 caused; and, in the same session, one test of the allocation hook, whose
 heap scopes must each be entered and left once; and the workload again with
-AGNOCAST_LTTNG=0, which must send nothing.  Starts a session daemon
-when none runs, and stops it again.
+AGNOCAST_LTTNG=0, which must send nothing.  Then the workload once more,
+with a session started only after it made its nodes, endpoints, timer and
+executor: the library sends their init events again for it, so the same
+checks hold.  Starts a session daemon when none runs, and stops it again.
 usage: lttng_events_test.py TRACE_WORKLOAD [HEAPHOOK_TESTS]
 (a sanitized build has no HEAPHOOK_TESTS: the sanitizer's malloc comes first)
 """
@@ -27,11 +29,12 @@ EVENT = re.compile(r"^\[(\d+\.\d+)\] \S+ agnocast:(\w+): (.*)$")
 FIELD = re.compile(r'(\w+) = ("(?:[^"\\]|\\.)*"|[^,}\s]+)')
 
 failures = []
+context = ""  # which recording the checks are of
 
 
 def check(condition, what):
     if not condition:
-        failures.append(what)
+        failures.append(context + what)
     return condition
 
 
@@ -87,6 +90,33 @@ def record(workload, heaphook_tests, output):
         return quiet.pid
     finally:
         subprocess.run(["lttng", "destroy", session], capture_output=True, timeout=60)
+
+
+def record_late(workload, output):
+    """The workload made everything before this session started."""
+    session = f"agnocast_events_late_{os.getpid()}"
+    late = subprocess.Popen([workload, str(MESSAGES), "--late"], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    try:
+        check(late.stdout.readline().strip() == "ready", "the late workload did not get ready")
+        lttng("create", session, f"--output={output}")
+        lttng("enable-event", "--userspace", "agnocast:*", f"--session={session}")
+        lttng("add-context", "--userspace", "--type=vpid", "--type=vtid", f"--session={session}")
+        lttng("start", session)
+        late.stdin.write("go\n")
+        late.stdin.flush()
+        check(late.wait(timeout=60) == 0, f"the late workload failed (exit {late.returncode})")
+        lttng("stop", session)
+    finally:
+        if late.poll() is None:
+            late.kill()
+        subprocess.run(["lttng", "destroy", session], capture_output=True, timeout=60)
+
+
+def read_trace(output):
+    text = subprocess.run(["babeltrace2", "--clock-seconds", "--no-delta", output],
+                          capture_output=True, text=True, timeout=120, check=True).stdout
+    return parse(text)
 
 
 def verify_heap_scopes(events):
@@ -232,20 +262,25 @@ def main():
         if not shutil.which(tool):
             sys.exit(f"FAIL: {tool} is missing: scripts/install-deps testbed installs it")
     before = session_daemons()
+    global context
     output = tempfile.mkdtemp(prefix="agnocast-lttng-")
+    late_output = tempfile.mkdtemp(prefix="agnocast-lttng-late-")
     try:
         opted_out = record(sys.argv[1], heaphook_tests, output)
-        text = subprocess.run(["babeltrace2", "--clock-seconds", "--no-delta", output],
-                              capture_output=True, text=True, timeout=120, check=True).stdout
-        events = parse(text)
+        events = read_trace(output)
         sent = sum(1 for _, _, f in events if f.get("vpid") == opted_out)
         check(sent == 0, f"the workload with AGNOCAST_LTTNG=0 sent {sent} events")
         events = [e for e in events if e[2].get("vpid") != opted_out]
         verify(events)
         if heaphook_tests:
             verify_heap_scopes(events)
+        context = "session started late: "
+        print("a session started after the workload made everything:")
+        record_late(sys.argv[1], late_output)
+        verify(read_trace(late_output))
     finally:
         shutil.rmtree(output, ignore_errors=True)
+        shutil.rmtree(late_output, ignore_errors=True)
         for pid in session_daemons() - before:
             os.kill(pid, signal.SIGTERM)
         deadline = time.monotonic() + 10

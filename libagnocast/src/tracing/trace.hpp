@@ -7,11 +7,22 @@
 
 #include <cstdint>
 
+// AGNOCAST_TRACE_INIT(owner, emit): an init event, `emit` a lambda holding
+// its AGNOCAST_TRACE with what it captured, sent now and again for a session
+// that enables the events later, until AGNOCAST_FORGET_INIT(owner) when the
+// owner goes (init_events.hpp); AGNOCAST_REPLAY_INIT() at each executor wait.
 #ifdef AGNOCAST_TRACING
+#include "tracing/init_events.hpp"
 #include "tracing/tracepoints.h"
 #define AGNOCAST_TRACE(event, ...) lttng_ust_tracepoint(agnocast, event, __VA_ARGS__)
+#define AGNOCAST_TRACE_INIT(owner, ...) ::agnocast::detail::keep_init_event(owner, __VA_ARGS__)
+#define AGNOCAST_FORGET_INIT(owner) ::agnocast::detail::forget_init_events(owner)
+#define AGNOCAST_REPLAY_INIT() ::agnocast::detail::replay_init_events()
 #else
 #define AGNOCAST_TRACE(event, ...) static_cast<void>(0)
+#define AGNOCAST_TRACE_INIT(owner, ...) static_cast<void>(0)
+#define AGNOCAST_FORGET_INIT(owner) static_cast<void>(0)
+#define AGNOCAST_REPLAY_INIT() static_cast<void>(0)
 #endif
 
 namespace agnocast::detail {

@@ -2,6 +2,9 @@
 // topic, a relay's callback publishes each message again on a second, and a
 // sink counts them, all through the in-process fake kernel. Exit 0 when the
 // sink received every message in order within the time limit.
+// usage: agnocast_trace_workload [COUNT [--late]]
+// --late: once everything is made, prints "ready" and waits for a line on
+// its standard input before it publishes (a session started meanwhile).
 #include <unistd.h>
 
 #include <chrono>
@@ -9,6 +12,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <iostream>
 #include <memory>
 #include <new>
 #include <string>
@@ -32,6 +37,7 @@ int main(int argc, char** argv) {
   using namespace agnocast;
   using namespace std::chrono_literals;
   const std::uint64_t count = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 20;
+  const bool late = argc > 2 && std::strcmp(argv[2], "--late") == 0;
   constexpr std::size_t pool_size = 4 << 20;
   auto* region = new (std::align_val_t{4096}) std::byte[pool_size];
   detail::Runtime::install_for_testing(region, pool_size, std::make_unique<detail::FakeKernel>());
@@ -68,6 +74,11 @@ int main(int argc, char** argv) {
   executor.add_node(source);
   executor.add_node(relay);
   executor.add_node(sink);
+  if (late) {
+    std::cout << "ready" << std::endl;
+    std::string go;
+    std::getline(std::cin, go);
+  }
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   while (received < count && std::chrono::steady_clock::now() < deadline) {
     executor.spin_once(100ms);

@@ -22,6 +22,8 @@
 #include <string>
 #include <string_view>
 
+#include "tracing/init_events.hpp"
+
 namespace agnocast::detail {
 namespace {
 
@@ -43,11 +45,11 @@ bool session_daemon_listening() {
   return home && has_application_socket(std::string(home) + "/.lttng");
 }
 
-void load_probes() {
+bool load_probes() {
   // secure_getenv: a set-user-ID program takes no say from its caller.
   const char* asked = ::secure_getenv("AGNOCAST_LTTNG");
   const std::string_view wanted = asked ? asked : "";
-  if (wanted == "0" || (wanted != "1" && !session_daemon_listening())) return;
+  if (wanted == "0" || (wanted != "1" && !session_daemon_listening())) return false;
   std::string path = AGNOCAST_LTTNG_PROVIDER;
   Dl_info self{};
   if (::dladdr(reinterpret_cast<void*>(&load_probes), &self) && self.dli_fname) {
@@ -58,10 +60,17 @@ void load_probes() {
     }
   }
   // Not found (a library built without its probes installed): the events stay off.
-  ::dlopen(path.c_str(), RTLD_NOW);
+  return ::dlopen(path.c_str(), RTLD_NOW) != nullptr;
 }
 
-[[maybe_unused]] const bool probes_loaded = (load_probes(), true);
+// At the process's start, before anything could be traced.
+[[maybe_unused]] const bool loaded_at_start = probes_loaded();
 
 }  // namespace
+
+bool probes_loaded() {
+  static const bool loaded = load_probes();
+  return loaded;
+}
+
 }  // namespace agnocast::detail

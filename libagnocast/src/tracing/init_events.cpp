@@ -1,5 +1,7 @@
 #include "tracing/init_events.hpp"
 
+#include <pthread.h>
+
 #include <atomic>
 #include <cstdint>
 #include <mutex>
@@ -22,12 +24,23 @@ struct InitEvents {
   std::atomic<bool> enabled_seen{false};
 };
 
+InitEvents*& registry();
+
+// A fork child starts with none: what it inherited is its parent's (and
+// another thread may have held the mutex as the process forked).
+InitEvents* make_registry() {
+  ::pthread_atfork(nullptr, nullptr, [] { registry() = new InitEvents; });
+  return new InitEvents;
+}
+
 // Never destroyed: objects may go, and executors wait, during static
 // destruction.
-InitEvents& init_events() {
-  static auto* events = new InitEvents;
-  return *events;
+InitEvents*& registry() {
+  static InitEvents* events = make_registry();
+  return events;
 }
+
+InitEvents& init_events() { return *registry(); }
 
 // agnocast_node_init stands for the provider's events: sessions enable them
 // together (`agnocast:*`).

@@ -76,10 +76,10 @@ class Injection {
 
 // For n = 1, 2, ...: `prepare` unarmed, then `call` with its nth allocation
 // failing, then `check` with n and whether one failed, until a run made
-// fewer than n.  Returns how many allocations were failed.
-unsigned each_allocation_failing(Injection& injection, const std::function<void()>& prepare,
-                                 const std::function<int()>& call,
-                                 const std::function<void(unsigned, int)>& check) {
+// fewer than n (it fails when the call made no allocation at all).
+void each_allocation_failing(Injection& injection, const std::function<void()>& prepare,
+                             const std::function<int()>& call,
+                             const std::function<void(unsigned, int)>& check) {
   for (unsigned n = 1; n < 500; ++n) {
     prepare();
     int result = 0;
@@ -91,13 +91,12 @@ unsigned each_allocation_failing(Injection& injection, const std::function<void(
       std::printf("%s, call %u: %u allocation(s) failed in turn\n",
                   ::testing::UnitTest::GetInstance()->current_test_info()->name(), ++calls, n - 1);
       EXPECT_GT(n, 1U) << "the call made no allocation: nothing was tested";
-      return n - 1;
+      return;
     }
     check(n, result);
-    if (::testing::Test::HasFatalFailure()) return n;
+    if (::testing::Test::HasFatalFailure()) return;
   }
   ADD_FAILURE() << "a call made 500 allocations or more";
-  return 500;
 }
 
 // After one of its allocations failed, a call either failed with ENOMEM or
@@ -123,7 +122,7 @@ TEST(AllocFailure, OpeningTheDeviceFailsCleanly) {
   Injection injection;
   SKIP_WITHOUT_INJECTION(injection);
   int fd = -1, error = 0;
-  const unsigned failed = each_allocation_failing(
+  each_allocation_failing(
       injection, [] {},
       [&] {
         fd = open_device();
@@ -141,7 +140,6 @@ TEST(AllocFailure, OpeningTheDeviceFailsCleanly) {
           EXPECT_EQ(error, ENOMEM) << "allocation " << n;
         }
       });
-  EXPECT_GT(failed, 0U);
 }
 
 TEST(AllocFailure, RegisteringFailsCleanly) {
@@ -166,14 +164,13 @@ TEST(AllocFailure, RegisteringFailsCleanly) {
   };
   // Step one: the slot.
   agnocast_register_process reg{};
-  EXPECT_GT(each_allocation_failing(
-                injection,
-                [&] {
-                  reg = poisoned_request<agnocast_register_process>();
-                  reg.pool_fd = -1;
-                },
-                [&] { return ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg); }, left_nothing(false)),
-            0U);
+  each_allocation_failing(
+      injection,
+      [&] {
+        reg = poisoned_request<agnocast_register_process>();
+        reg.pool_fd = -1;
+      },
+      [&] { return ioc(dev, AGNOCAST_IOC_REGISTER_PROCESS, &reg); }, left_nothing(false));
   // Step two: the pool, made and sealed unarmed, its slot reserved.
   Registration pool;
   agnocast_register_process attach{};
@@ -251,19 +248,15 @@ TEST_F(AllocFailureRegistered, AddingEndpointsFailsCleanly) {
       }
     };
   };
-  EXPECT_GT(each_allocation_failing(
-                injection, [&] { request(10); },
-                [&] { return ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep); },
-                left_nothing(AGNOCAST_IOC_REMOVE_PUBLISHER, publishers_of)),
-            0U);
+  each_allocation_failing(
+      injection, [&] { request(10); }, [&] { return ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep); },
+      left_nothing(AGNOCAST_IOC_REMOVE_PUBLISHER, publishers_of));
   // A publisher of the same type keeps the topic while subscribers come and go.
   request(10);
   ASSERT_EQ(ioc(dev, AGNOCAST_IOC_ADD_PUBLISHER, &ep), 0);
-  EXPECT_GT(each_allocation_failing(
-                injection, [&] { request(1000); },
-                [&] { return ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep); },
-                left_nothing(AGNOCAST_IOC_REMOVE_SUBSCRIBER, subscribers_of)),
-            0U);
+  each_allocation_failing(
+      injection, [&] { request(1000); }, [&] { return ioc(dev, AGNOCAST_IOC_ADD_SUBSCRIBER, &ep); },
+      left_nothing(AGNOCAST_IOC_REMOVE_SUBSCRIBER, subscribers_of));
 }
 
 TEST_F(AllocFailureRegistered, PublishReceiveAndReleaseFailCleanly) {

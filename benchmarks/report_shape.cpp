@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 #include <tuple>
+#include <vector>
 
 namespace agnocast::bench {
 namespace {
@@ -933,6 +934,81 @@ void print_why_round_trip_stands(const json& icount) {
       number(breakdown["switches_ns"], "%.0f").c_str(), tail);
 }
 
+// What the module's trace events and libagnocast's LTTng-UST call sites cost
+// while nobody traces: the same series as built, with the module built without
+// its events, and with libagnocast built without its provider as well.
+void print_tracing_cost(const json& combined) {
+  const json& runs = combined["tracing_cost"];
+  if (!runs.is_object()) return;
+  const char* variants[] = {"traced", "module_untraced", "untraced"};
+  struct Row {
+    std::string label;
+    double values[3];
+  };
+  std::vector<Row> rows;
+  auto add_call = [&](const char* label, const char* side, const char* call) {
+    Row row{label, {}};
+    for (int i = 0; i < 3; ++i)
+      row.values[i] = call_ns(runs[variants[i]]["cost_breakdown"], side, call);
+    rows.push_back(row);
+  };
+  auto add_latency = [&](const char* label, const char* size) {
+    Row row{label, {}};
+    for (int i = 0; i < 3; ++i) {
+      row.values[i] =
+          number_or_nan(at_path(runs[variants[i]], {"latency", "agnocast", size, "p50_us"})) * 1000;
+    }
+    rows.push_back(row);
+  };
+  add_call("`ioctl` PUBLISH", "publisher", "ioctl PUBLISH");
+  add_call("`ioctl` RECEIVE", "subscriber", "ioctl RECEIVE");
+  add_latency("agnocast one way, 64 B, p50", "64 B");
+  add_latency("agnocast one way, 4 KiB, p50", "4 KiB");
+  auto change = [](double with, double without) {
+    if (std::isnan(with) || std::isnan(without) || without <= 0) return std::string("—");
+    char text[32];
+    std::snprintf(text, sizeof text, "%+.2f %%", (with / without - 1) * 100);
+    return std::string(text);
+  };
+  std::printf(
+      "\n## What tracing costs while nobody traces\n\n"
+      "In the same icount boot, agnocast's 64 B and 4 KiB series and the cost breakdown ran "
+      "three more times: as built (the module's trace events disabled, libagnocast's LTTng-UST "
+      "call sites and no session), with an `agnocast.ko` built without its trace events, and "
+      "with a libagnocast built without its provider (`AGNOCAST_TRACING=OFF`) as well.  The "
+      "events' cost is the first against the second; the provider's the second against the "
+      "third.  Another build moves where code and data fall, and with them the page faults "
+      "and the kernel's per-page work a sample meets: a p50 moves by a few tenths of a percent "
+      "either way, and a negative cost is that.\n\n"
+      "| ns (instructions) | as built | module without its events | and libagnocast without "
+      "its provider | the events' cost | the provider's cost |\n|---|---|---|---|---|---|\n");
+  auto ns = [](double value) { return std::isnan(value) ? "—" : number(json(value), "%.0f"); };
+  for (const Row& row : rows) {
+    std::printf("| %s | %s | %s | %s | %s | %s |\n", row.label.c_str(), ns(row.values[0]).c_str(),
+                ns(row.values[1]).c_str(), ns(row.values[2]).c_str(),
+                change(row.values[0], row.values[1]).c_str(),
+                change(row.values[1], row.values[2]).c_str());
+  }
+  auto within = [&](std::initializer_list<std::pair<double, double>> pairs) {
+    bool measured = true, met = true;
+    for (const auto& [with, without] : pairs) {
+      if (std::isnan(with) || std::isnan(without) || without <= 0)
+        measured = false;
+      else if (with / without > 1.01)
+        met = false;
+    }
+    return !measured ? "not measured" : met ? "**met**" : "**not met**";
+  };
+  std::printf(
+      "\n- disabled trace events cost PUBLISH, RECEIVE and the one way at most 1 %%: %s\n"
+      "- libagnocast's call sites with no session cost the one way at most 1 %%: %s\n",
+      within({{rows[0].values[0], rows[0].values[1]},
+              {rows[1].values[0], rows[1].values[1]},
+              {rows[2].values[0], rows[2].values[1]},
+              {rows[3].values[0], rows[3].values[1]}}),
+      within({{rows[2].values[1], rows[2].values[2]}, {rows[3].values[1], rows[3].values[2]}}));
+}
+
 }  // namespace
 
 void print_readme(const json& combined, const std::map<std::string, PlotLinks>& plots) {
@@ -1306,6 +1382,7 @@ release's deadline (at most 4 ms after the wake-up that left it) is the
 timeout of the executor's wait, so no timer is set, read or woken for while
 messages keep coming.
 )");
+  print_tracing_cost(combined);
   print_what_would_change(icount);
 }
 

@@ -60,15 +60,17 @@ if(NOT KDIR)
 endif()
 
 # agnocast_add_kernel_module(TARGET name SOURCE_DIR dir MODULE_NAME name
-#                            [KDIR dir] [COVERAGE])
+#                            [KDIR dir] [COVERAGE] [UNTRACED])
 # Builds the Kbuild module in SOURCE_DIR (its Kbuild file, *.c, *.h and
 # include/) out of tree with W=1 against KDIR (default: the stock kernel's).
 # COVERAGE passes AGNOCAST_COVERAGE=1, which the module's Kbuild turns into
-# gcov and kcov instrumentation (for a kernel built with both).
+# gcov and kcov instrumentation (for a kernel built with both).  UNTRACED
+# passes AGNOCAST_UNTRACED=1 (a module without its trace events), and leaves
+# the target out of the default build.
 # Sets <name>_KO in the caller's scope to the resulting .ko and makes it the
 # target's KO property.
 function(agnocast_add_kernel_module)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "COVERAGE" "TARGET;SOURCE_DIR;MODULE_NAME;KDIR" "")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "COVERAGE;UNTRACED" "TARGET;SOURCE_DIR;MODULE_NAME;KDIR" "")
   if(NOT arg_KDIR)
     set(arg_KDIR "${KDIR}")
   endif()
@@ -84,11 +86,17 @@ function(agnocast_add_kernel_module)
     COMMAND ${CMAKE_COMMAND} -E rm -rf "${build_dir}/tests"
     COMMAND make -C "${arg_KDIR}" "M=${build_dir}" W=1
             "AGNOCAST_WERROR=$<BOOL:${AGNOCAST_WERROR}>"
-            "AGNOCAST_COVERAGE=$<BOOL:${arg_COVERAGE}>" modules
+            "AGNOCAST_COVERAGE=$<BOOL:${arg_COVERAGE}>"
+            "AGNOCAST_UNTRACED=$<BOOL:${arg_UNTRACED}>" modules
     DEPENDS ${sources}
     COMMENT "Building ${arg_MODULE_NAME}.ko against ${arg_KDIR}"
     VERBATIM)
-  add_custom_target(${arg_TARGET} ALL DEPENDS "${ko}")
+  # A module without its trace events is built only when asked for.
+  set(all ALL)
+  if(arg_UNTRACED)
+    set(all "")
+  endif()
+  add_custom_target(${arg_TARGET} ${all} DEPENDS "${ko}")
   set_target_properties(${arg_TARGET} PROPERTIES KO "${ko}")
   set(${arg_TARGET}_KO "${ko}" PARENT_SCOPE)
 endfunction()

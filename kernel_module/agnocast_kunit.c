@@ -14,7 +14,9 @@
 #include <linux/slab.h>
 
 /* Its copy of the engine traces nothing: agnocast.ko owns the events. */
+#ifndef AGNOCAST_UNTRACED
 #define AGNOCAST_UNTRACED
+#endif
 #include "agnocast_entry.c"
 
 /* The parameter the engine reads; tests set it. */

@@ -977,9 +977,7 @@ void print_tracing_cost(const json& combined) {
       "call sites and no session), with an `agnocast.ko` built without its trace events, and "
       "with a libagnocast built without its provider (`AGNOCAST_TRACING=OFF`) as well.  The "
       "events' cost is the first against the second; the provider's the second against the "
-      "third.  Another build moves where code and data fall, and with them the page faults "
-      "and the kernel's per-page work a sample meets: a p50 moves by a few tenths of a percent "
-      "either way, and a negative cost is that.\n\n"
+      "third.\n\n"
       "| ns (instructions) | as built | module without its events | and libagnocast without "
       "its provider | the events' cost | the provider's cost |\n|---|---|---|---|---|---|\n");
   auto ns = [](double value) { return std::isnan(value) ? "—" : number(json(value), "%.0f"); };
@@ -988,6 +986,19 @@ void print_tracing_cost(const json& combined) {
                 ns(row.values[1]).c_str(), ns(row.values[2]).c_str(),
                 change(row.values[0], row.values[1]).c_str(),
                 change(row.values[1], row.values[2]).c_str());
+  }
+  // The same build, the same series, earlier in the same boot: how far the
+  // state a boot is in moves a p50 with no change to the code.
+  const double earlier =
+      number_or_nan(at_path(combined, {"icount", "latency", "agnocast", "64 B", "p50_us"})) * 1000;
+  if (!std::isnan(earlier) && !std::isnan(rows[2].values[0])) {
+    std::printf(
+        "\nThe same build's 64 B p50 earlier in this boot (the latency table above) was %.0f; "
+        "the first column's is %s against it.  That much a p50 moves with no change to the "
+        "code, as the pages a sample meets, and the kernel's work on them, change with what "
+        "ran before: a cost within that, or a negative one, is one these runs cannot tell from "
+        "none.\n",
+        earlier, change(rows[2].values[0], earlier).c_str());
   }
   auto within = [&](std::initializer_list<std::pair<double, double>> pairs) {
     bool measured = true, met = true;

@@ -1,5 +1,6 @@
 #include "kernel/runtime.hpp"
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <pthread.h>
 #include <sys/mman.h>
@@ -36,6 +37,20 @@ std::string address_hex(std::uint64_t value) {
   throw Error("agnocast: " + what + ": " + std::strerror(err));
 }
 
+// What to do when an address range is taken: the module's default pool_base
+// lies in AddressSanitizer's shadow memory, which its runtime reserves at
+// start.  (ThreadSanitizer's runtime stops the process itself, naming the
+// address.)
+std::string occupied_hint() {
+  std::string hint = "; something else occupies that address range";
+  if (::dlsym(RTLD_DEFAULT, "__asan_init") != nullptr) {
+    hint +=
+        " (this process runs under AddressSanitizer, whose shadow memory may cover it: load "
+        "agnocast.ko with pool_base=0x200000000000)";
+  }
+  return hint;
+}
+
 // Maps fd at exactly addr, refusing to replace anything unless replace is set.
 void map_at(std::uint64_t addr, std::uint64_t size, int prot, int fd, bool replace,
             const std::string& what) {
@@ -46,7 +61,7 @@ void map_at(std::uint64_t addr, std::uint64_t size, int prot, int fd, bool repla
     const int err = errno;
     throw Error("agnocast: cannot map " + what + " at " + address_hex(addr) + " (" +
                 std::to_string(size) + " bytes): " + std::strerror(err) +
-                (err == EEXIST ? "; something else occupies that address range" : ""));
+                (err == EEXIST ? occupied_hint() : ""));
   }
   if (mapped != wanted) {  // kernels before 4.17 treat MAP_FIXED_NOREPLACE as a hint
     ::munmap(mapped, size);

@@ -7,7 +7,9 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <string>
 
+#include "agnocast/errors.hpp"
 #include "kernel/fake_kernel.hpp"
 
 namespace agnocast::detail {
@@ -40,6 +42,35 @@ TEST(PoolHolding, FindsTheOwnOrMappedPoolThatHoldsAnAddress) {
   EXPECT_TRUE(runtime.pool_holding(own + pool_size).empty());
   const int on_the_stack = 0;
   EXPECT_TRUE(runtime.pool_holding(&on_the_stack).empty());
+}
+
+// A pool granted where this process already has a mapping is refused, named,
+// and under AddressSanitizer (whose shadow covers the module's default
+// pool_base) with the parameter that moves the pools out of it.
+TEST(PoolMapping, AnOccupiedRangeIsRefusedWithTheWayOut) {
+  auto* own = new (std::align_val_t{4096}) std::byte[pool_size];
+  Runtime& runtime = Runtime::install_for_testing(own, pool_size, std::make_unique<FakeKernel>());
+  void* taken = ::mmap(nullptr, pool_size, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(taken, MAP_FAILED);
+  PoolGrant grant = publisher_pool();
+  grant.addr = reinterpret_cast<std::uint64_t>(taken);
+  std::string message;
+  try {
+    runtime.map_pool(grant);
+  } catch (const Error& error) {
+    message = error.what();
+  }
+  ::munmap(taken, pool_size);
+  EXPECT_NE(message.find("cannot map the pool of publisher pid 4242"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("something else occupies that address range"), std::string::npos)
+      << message;
+#if defined(__SANITIZE_ADDRESS__)
+  EXPECT_NE(message.find("pool_base=0x200000000000"), std::string::npos) << message;
+#else
+  EXPECT_EQ(message.find("AddressSanitizer"), std::string::npos) << message;
+#endif
+  EXPECT_TRUE(runtime.pool_holding(taken).empty());
 }
 
 }  // namespace

@@ -33,9 +33,14 @@ unsigned int agnocast_pool_count = 1024;
 module_param_named(pool_count, agnocast_pool_count, uint, 0444);
 MODULE_PARM_DESC(pool_count, "Pool slots per IPC namespace (default 1024)");
 
-unsigned long agnocast_pool_base = 0x40000000000UL;
+/*
+ * 32 TiB: above AddressSanitizer's shadow memory (which ends at
+ * 0x10007fff8000), so programs built with it map pools where the module puts
+ * them.
+ */
+unsigned long agnocast_pool_base = 0x200000000000UL;
 module_param_named(pool_base, agnocast_pool_base, ulong, 0444);
-MODULE_PARM_DESC(pool_base, "Address of slot 0 (page aligned, default 0x40000000000)");
+MODULE_PARM_DESC(pool_base, "Address of slot 0 (page aligned, default 0x200000000000)");
 
 unsigned int agnocast_max_endpoints_per_process = 1024;
 module_param_named(max_endpoints_per_process, agnocast_max_endpoints_per_process, uint, 0444);

@@ -445,7 +445,9 @@ TEST_F(CliLive, VersionReportsTheLoadedModule) {
 TEST_F(CliLive, DoctorWithoutDaemonFailsOnlyTheDaemonCheck) {
   const Outcome r = cli("doctor --json");
   EXPECT_EQ(r.code, 1);
-  for (const json& check : r.value()["checks"]) {
+  const json checks = r.value()["checks"];
+  ASSERT_FALSE(checks.empty());
+  for (const json& check : checks) {
     EXPECT_EQ(check["ok"], check["name"] != "daemon") << check.dump();
   }
   const Outcome table = cli("doctor");
@@ -544,7 +546,9 @@ TEST_F(CliLive, WithoutTheModuleDoctorFailsAndCommandsSayHowToFix) {
 
   const Outcome doctor = cli("doctor --json");
   EXPECT_EQ(doctor.code, 1);
-  for (const json& check : doctor.value()["checks"]) {
+  const json checks = doctor.value()["checks"];
+  ASSERT_FALSE(checks.empty());
+  for (const json& check : checks) {
     if (check["name"] == "module" || check["name"] == "device" || check["name"] == "version") {
       EXPECT_EQ(check["ok"], false) << check.dump();
     }
@@ -557,7 +561,8 @@ TEST_F(CliLive, WithoutTheModuleDoctorFailsAndCommandsSayHowToFix) {
   EXPECT_EQ(version.code, 0);
   EXPECT_TRUE(version.value()["module"].is_null());
   // Every leftover queue is stale without the module.
-  for (const json& q : cli("queue list --json").value()["queues"]) {
+  const json queues = cli("queue list --json").value()["queues"];
+  for (const json& q : queues) {
     EXPECT_EQ(q["stale"], true) << q.dump();
   }
 

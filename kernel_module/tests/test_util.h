@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <optional>
 #include <string>
@@ -55,6 +56,15 @@ T poisoned_request()
 inline int open_device(int flags = O_RDWR)
 {
   return ::open(AGNOCAST_DEVICE_PATH, flags | O_CLOEXEC);
+}
+
+// Where the loaded module puts slot 0 (its pool_base parameter), or 0.
+inline uint64_t module_pool_base()
+{
+  std::ifstream in("/sys/module/agnocast/parameters/pool_base");
+  uint64_t base = 0;
+  in >> base;
+  return base;
 }
 
 // ioctl returning 0 or -errno.
@@ -212,8 +222,9 @@ inline int receive(int dev, Endpoint sub, ReceiveResult *res, uint32_t entry_cap
 {
   std::vector<agnocast_entry> entries(entry_capacity);
   std::vector<agnocast_pool> pools(pool_capacity);
-  std::memset(entries.data(), kPoison, entries.size() * sizeof(entries[0]));
-  std::memset(pools.data(), kPoison, pools.size() * sizeof(pools[0]));
+  // An empty vector's data() may be null, which memset may not be given.
+  if (!entries.empty()) std::memset(entries.data(), kPoison, entries.size() * sizeof(entries[0]));
+  if (!pools.empty()) std::memset(pools.data(), kPoison, pools.size() * sizeof(pools[0]));
   agnocast_receive arg = poisoned<agnocast_receive>();
   arg.topic_handle = sub.handle;
   arg.subscriber_id = sub.id;

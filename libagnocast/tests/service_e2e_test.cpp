@@ -207,6 +207,15 @@ TEST(Services, AThousandClientsComeAndGoAndTheServerReturnsToItsBaseline) {
   agnocast::SingleThreadedExecutor executor;
   executor.add_node(node);
   std::thread spinner([&] { executor.spin(); });
+  // A failed assertion returns early: the spinner stops and is joined then too.
+  struct StopSpinner {
+    agnocast::SingleThreadedExecutor& executor;
+    std::thread& spinner;
+    ~StopSpinner() {
+      executor.cancel();
+      if (spinner.joinable()) spinner.join();
+    }
+  } stop_spinner{executor, spinner};
   // Each child: clients made, called once and destroyed, one after another;
   // the last child is killed holding a client with a call pending.
   const auto callers = [&](int clients, bool then_hang) {
@@ -236,7 +245,11 @@ TEST(Services, AThousandClientsComeAndGoAndTheServerReturnsToItsBaseline) {
       wait_child(child);
       return true;
     }
-    return exited_ok(wait_child(child));
+    // 2: no service within 10 s; 3: no answer within 10 s; 4: a wrong one.
+    const int status = wait_child(child);
+    if (!exited_ok(status))
+      std::printf("a child of %d callers ended with status %#x\n", clients, status);
+    return exited_ok(status);
   };
   ASSERT_TRUE(callers(100, false));
   ::malloc_trim(0);

@@ -37,16 +37,16 @@ std::string address_hex(std::uint64_t value) {
   throw Error("agnocast: " + what + ": " + std::strerror(err));
 }
 
-// What to do when an address range is taken: the module's default pool_base
-// lies in AddressSanitizer's shadow memory, which its runtime reserves at
-// start.  (ThreadSanitizer's runtime stops the process itself, naming the
-// address.)
+// What to do when an address range is taken.  AddressSanitizer's runtime
+// reserves its shadow memory at start, below 0x10007fff8000: a module loaded
+// with a pool_base there puts pools where no such process can map them.
+// (ThreadSanitizer's runtime stops the process itself, naming the address.)
 std::string occupied_hint() {
   std::string hint = "; something else occupies that address range";
   if (::dlsym(RTLD_DEFAULT, "__asan_init") != nullptr) {
     hint +=
         " (this process runs under AddressSanitizer, whose shadow memory may cover it: load "
-        "agnocast.ko with pool_base=0x200000000000)";
+        "agnocast.ko with a pool_base above 0x10007fff8000, as its default 0x200000000000 is)";
   }
   return hint;
 }

@@ -39,8 +39,6 @@ AGNOCAST_MESSAGE(agnocast::bench::SmallMessage, "agnocast_bench/msg/Small", seq,
 namespace agnocast::bench {
 namespace {
 
-using nlohmann::json;
-
 std::int64_t cpu_ns_of(const rusage& usage) {
   auto ns = [](const timeval& time) {
     return static_cast<std::int64_t>(time.tv_sec) * 1'000'000'000 +
@@ -221,9 +219,9 @@ RecordingRun record_while(const std::string& cli, const std::string& topic, std:
   run.recorded = scanned.messages;
   run.complete = scanned.reached_data_end && scanned.stopped.empty();
   std::ifstream in(summary);
-  json reported = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  nlohmann::json reported = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
   if (reported.is_object() && reported.contains("topics")) {
-    for (const json& entry : reported["topics"]) {
+    for (const nlohmann::json& entry : reported["topics"]) {
       run.dropped_reported += entry.value("dropped", std::uint64_t{0});
     }
   }
@@ -232,36 +230,36 @@ RecordingRun record_while(const std::string& cli, const std::string& topic, std:
   return run;
 }
 
-json run_json(const RecordingRun& run, std::size_t bytes, double rate_hz) {
+nlohmann::json run_json(const RecordingRun& run, std::size_t bytes, double rate_hz) {
   const double recorded = static_cast<double>(run.recorded);
-  return {
-      {"payload_bytes", bytes},
-      {"rate_hz", rate_hz},
-      {"published", run.published},
-      {"recorded", run.recorded},
-      {"lost", run.published > run.recorded ? run.published - run.recorded : 0},
-      {"dropped_reported", run.dropped_reported},
-      {"recorder_cpu_ms", static_cast<double>(run.recorder_cpu_ns) / 1e6},
-      {"recorder_start_up_cpu_ms", static_cast<double>(run.recorder_start_cpu_ns) / 1e6},
-      // From its subscription to its exit: the messages, the file's end.
-      {"cpu_us_per_message",
-       recorded > 0 ? json(static_cast<double>(run.recorder_cpu_ns - run.recorder_start_cpu_ns) /
-                           1e3 / recorded)
-                    : json()},
-      {"file_bytes", run.file_bytes},
-      {"complete", run.complete},
-      {"wall_s", run.seconds}};
+  return {{"payload_bytes", bytes},
+          {"rate_hz", rate_hz},
+          {"published", run.published},
+          {"recorded", run.recorded},
+          {"lost", run.published > run.recorded ? run.published - run.recorded : 0},
+          {"dropped_reported", run.dropped_reported},
+          {"recorder_cpu_ms", static_cast<double>(run.recorder_cpu_ns) / 1e6},
+          {"recorder_start_up_cpu_ms", static_cast<double>(run.recorder_start_cpu_ns) / 1e6},
+          // From its subscription to its exit: the messages, the file's end.
+          {"cpu_us_per_message",
+           recorded > 0 ? nlohmann::json(
+                              static_cast<double>(run.recorder_cpu_ns - run.recorder_start_cpu_ns) /
+                              1e3 / recorded)
+                        : nlohmann::json()},
+          {"file_bytes", run.file_bytes},
+          {"complete", run.complete},
+          {"wall_s", run.seconds}};
 }
 
 }  // namespace
 
-json run_recording(const std::string& cli, bool smoke) {
+nlohmann::json run_recording(const std::string& cli, bool smoke) {
   int counter = 0;
   auto topic_name = [&](const char* kind) {
     return std::string("/bench/recorded_") + kind + "_" + std::to_string(::getpid()) + "_" +
            std::to_string(counter++);
   };
-  json result = json::object();
+  nlohmann::json result = nlohmann::json::object();
 
   {
     constexpr std::size_t cloud_bytes = 4 << 20;

@@ -10,9 +10,10 @@
 //                   name's agnocast server (deferred); each request goes out on
 //                   rq/ with a header of the bridge's own, and the reply that
 //                   comes back on rr/ with that header answers the agnocast
-//                   client. A request not answered within the timeout fails
-//                   (Service::fail_request), as does one sent when no DDS
-//                   server is matched: nothing stays pending.
+//                   client. A request made while no DDS server is matched
+//                   waits for one; a request not answered within the
+//                   timeout, waiting or sent, fails (Service::fail_request):
+//                   nothing stays pending.
 #pragma once
 
 #include <dds/dds.h>
@@ -20,6 +21,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -44,7 +46,7 @@
 namespace agnocast_bridge {
 
 // What a service relay needs from the bridge. Counters: relayed = calls
-// answered, dropped = calls not answered (DDS timeout, no DDS server, the
+// answered, dropped = calls not answered (no reply in time, too many waiting, the
 // agnocast side refused or had no server), errors = bytes that are not valid
 // XCDR1 for the type, or a DDS error.
 struct ServiceRelayContext {
@@ -182,11 +184,12 @@ class ServiceFromDds : public Relay {
         [this](std::shared_ptr<agnocast::Service<Srv>>, agnocast::RequestId id,
                agnocast::ipc_shared_ptr<const Request> request) { forward(id, *request); });
     // Often enough that a request fails within a tenth of its timeout (at
-    // least 10 ms) after it.
+    // least 10 ms, at most 100 ms) after it, and that one waiting for a DDS
+    // server goes out as soon after the match.
     sweeper_ = context.node.create_wall_timer(
         std::clamp<std::chrono::milliseconds>(timeout_ / 10, std::chrono::milliseconds(10),
                                               std::chrono::milliseconds(100)),
-        [this] { fail_expired(); });
+        [this] { sweep(); });
   }
 
   dds_entity_t reader() const override { return dds_.reader.get(); }
@@ -201,6 +204,14 @@ class ServiceFromDds : public Relay {
     agnocast::RequestId id;
     std::chrono::steady_clock::time_point deadline;
   };
+  // A request not yet sent: no DDS server was matched when it came.  As many
+  // wait as one agnocast client may have in flight; more fail at once.
+  static constexpr std::size_t max_waiting = agnocast::qos_depth_max;
+  struct Waiting {
+    agnocast::RequestId id;
+    std::chrono::steady_clock::time_point deadline;
+    std::vector<std::uint8_t> bytes;
+  };
 
   // On the executor's thread: the agnocast client's request goes to DDS.
   void forward(const agnocast::RequestId& id, const Request& request) {
@@ -212,24 +223,50 @@ class ServiceFromDds : public Relay {
       fail(id);
       return;
     }
-    dds_publication_matched_status_t matched{};
-    if (dds_get_publication_matched_status(dds_.writer.get(), &matched) == DDS_RETCODE_OK &&
-        matched.current_count == 0) {
-      ++counters_.dropped;  // no DDS server: fail now rather than at the timeout
+    // Until discovery has matched a DDS server both ways, a request written
+    // would reach nobody, or its reply would: it waits, behind any others.
+    if (waiting_.size() == max_waiting) {
+      ++counters_.dropped;
       fail(id);
       return;
     }
+    waiting_.push_back({id, std::chrono::steady_clock::now() + timeout_, std::move(bytes)});
+    send_waiting();
+  }
+
+  // A DDS server is matched when a reader takes our requests and a writer
+  // can answer on our reply topic.
+  bool server_matched() const {
+    dds_publication_matched_status_t requests{};
+    dds_subscription_matched_status_t replies{};
+    return dds_get_publication_matched_status(dds_.writer.get(), &requests) == DDS_RETCODE_OK &&
+           requests.current_count > 0 &&
+           dds_get_subscription_matched_status(dds_.reader.get(), &replies) == DDS_RETCODE_OK &&
+           replies.current_count > 0;
+  }
+
+  // On the executor's thread: a request goes out on DDS, pending its reply.
+  void send(Waiting&& request) {
     std::int64_t sequence = 0;
     {
       std::lock_guard lock(mutex_);
       sequence = ++next_sequence_;
-      pending_.emplace(sequence, Pending{id, std::chrono::steady_clock::now() + timeout_});
+      pending_.emplace(sequence, Pending{request.id, request.deadline});
     }
-    const dds_return_t written = dds_.write({client_id_, sequence}, std::move(bytes));
+    const dds_return_t written = dds_.write({client_id_, sequence}, std::move(request.bytes));
     if (written != DDS_RETCODE_OK) {
       ++(written == DDS_RETCODE_TIMEOUT ? counters_.dropped : counters_.errors);
-      if (take_pending(sequence)) fail(id);
+      if (take_pending(sequence)) fail(request.id);
     }
+  }
+
+  // On the executor's thread: the requests that waited for a DDS server go
+  // out, in the order they came, once one is matched.
+  void send_waiting() {
+    if (waiting_.empty() || !server_matched()) return;
+    std::deque<Waiting> ready;
+    ready.swap(waiting_);
+    for (Waiting& request : ready) send(std::move(request));
   }
 
   // On the DDS receiver's thread: a reply; those to other clients are not ours.
@@ -258,12 +295,18 @@ class ServiceFromDds : public Relay {
     fail(*id);
   }
 
-  // On the executor's thread: requests whose time is up fail.
-  void fail_expired() {
+  // On the executor's thread: requests that waited for a DDS server go out
+  // or, like those sent, fail when their time is up.
+  void sweep() {
+    send_waiting();
+    const auto now = std::chrono::steady_clock::now();
     std::vector<agnocast::RequestId> expired;
+    while (!waiting_.empty() && waiting_.front().deadline <= now) {
+      expired.push_back(waiting_.front().id);
+      waiting_.pop_front();
+    }
     {
       std::lock_guard lock(mutex_);
-      const auto now = std::chrono::steady_clock::now();
       for (auto it = pending_.begin(); it != pending_.end();) {
         if (it->second.deadline > now) {
           ++it;
@@ -304,6 +347,8 @@ class ServiceFromDds : public Relay {
   std::mutex mutex_;  // guards next_sequence_ and pending_
   std::int64_t next_sequence_ = 0;
   std::map<std::int64_t, Pending> pending_;
+  // Only the executor's thread touches it; deadlines in arrival order.
+  std::deque<Waiting> waiting_;
   // The service answers from the executor's thread and the DDS receiver's.
   std::mutex service_mutex_;
   std::shared_ptr<agnocast::Service<Srv>> service_;

@@ -5,7 +5,8 @@
 //   agnocast-bridge-test-service-node serve-set-bool SERVICE COUNT TIMEOUT_S
 //
 // call-add-two-ints calls AddTwoInts COUNT times (a = i, b = 1000 i, up to 8
-// in flight) and exits 0 when every sum is right. call-unanswered sends one
+// in flight; "@sent N" once the first N are sent) and exits 0 when every sum
+// is right. call-unanswered sends one
 // AddTwoInts request and exits 0 when its future throws ServiceUnavailable no
 // sooner than MIN_MS and no later than MAX_MS after the call. serve-set-bool
 // serves SetBool (success = data, message "set to true" or "set to false"),
@@ -50,12 +51,18 @@ int call_add_two_ints(const std::string& service, std::uint32_t count) {
   executor.add_node(node);
   std::deque<std::pair<std::uint32_t, agnocast::Client<AddTwoInts>::SharedFuture>> in_flight;
   std::uint32_t sent = 0, right = 0, wrong = 0;
+  bool announced = false;
   while (right + wrong < count) {
     while (sent < count && in_flight.size() < 8) {
       auto request = client->borrow_loaned_request();
       request->a = sent;
       request->b = 1000LL * sent;
       in_flight.emplace_back(sent++, client->async_send_request(std::move(request)));
+    }
+    if (!announced) {  // for a test that starts the server only then
+      std::printf("@sent %zu\n", in_flight.size());
+      std::fflush(stdout);
+      announced = true;
     }
     auto [i, future] = in_flight.front();
     in_flight.pop_front();

@@ -6,11 +6,11 @@
 //
 // call-add-two-ints calls AddTwoInts COUNT times (a = i, b = 1000 i, up to 8
 // in flight; "@sent N" once the first N are sent) and exits 0 when every sum
-// is right. call-unanswered sends one
-// AddTwoInts request and exits 0 when its future throws ServiceUnavailable no
-// sooner than MIN_MS and no later than MAX_MS after the call. serve-set-bool
-// serves SetBool (success = data, message "set to true" or "set to false"),
-// prints "@ready" once serving, and exits 0 after COUNT requests.
+// is right. call-unanswered sends one AddTwoInts request and exits 0 when its
+// future throws ServiceUnavailable no sooner than MIN_MS and no later than
+// MAX_MS after the call. serve-set-bool serves SetBool (success = data,
+// message "set to true" or "set to false"), prints "@ready" once serving, and
+// exits 0 after COUNT requests.
 #include <agnocast/agnocast.hpp>
 #include <chrono>
 #include <cstdint>

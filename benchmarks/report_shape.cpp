@@ -934,11 +934,10 @@ void print_why_round_trip_stands(const json& icount) {
       number(breakdown["switches_ns"], "%.0f").c_str(), tail);
 }
 
-// What the module's trace events and libagnocast's LTTng-UST call sites cost
-// while nobody traces: the same series as built, with the module built without
-// its events, and with libagnocast built without its provider as well.
+}  // namespace
+
 void print_tracing_cost(const json& combined) {
-  const json& runs = combined["tracing_cost"];
+  const json& runs = at_path(combined, {"tracing_cost"});
   if (!runs.is_object()) return;
   const char* variants[] = {"traced", "module_untraced", "untraced"};
   struct Row {
@@ -949,14 +948,14 @@ void print_tracing_cost(const json& combined) {
   auto add_call = [&](const char* label, const char* side, const char* call) {
     Row row{label, {}};
     for (int i = 0; i < 3; ++i)
-      row.values[i] = call_ns(runs[variants[i]]["cost_breakdown"], side, call);
+      row.values[i] = call_ns(at_path(runs, {variants[i], "cost_breakdown"}), side, call);
     rows.push_back(row);
   };
   auto add_latency = [&](const char* label, const char* size) {
     Row row{label, {}};
     for (int i = 0; i < 3; ++i) {
       row.values[i] =
-          number_or_nan(at_path(runs[variants[i]], {"latency", "agnocast", size, "p50_us"})) * 1000;
+          number_or_nan(at_path(runs, {variants[i], "latency", "agnocast", size, "p50_us"})) * 1000;
     }
     rows.push_back(row);
   };
@@ -1019,8 +1018,6 @@ void print_tracing_cost(const json& combined) {
               {rows[3].values[0], rows[3].values[1]}}),
       within({{rows[2].values[1], rows[2].values[2]}, {rows[3].values[1], rows[3].values[2]}}));
 }
-
-}  // namespace
 
 void print_readme(const json& combined, const std::map<std::string, PlotLinks>& plots) {
   const json& icount = combined["icount"];

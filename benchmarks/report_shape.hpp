@@ -24,4 +24,11 @@ void print_markdown(const nlohmann::ordered_json& report, const PlotLinks& plots
 void print_readme(const nlohmann::ordered_json& combined,
                   const std::map<std::string, PlotLinks>& plots = {});
 
+// The README's section on what the module's trace events and libagnocast's
+// LTTng-UST call sites cost while nobody traces, from the combined report's
+// "tracing_cost" (the same series as built, with the module built without
+// its events, and with libagnocast built without its provider as well);
+// nothing when it has none.  A run missing from it shows as "—".
+void print_tracing_cost(const nlohmann::ordered_json& combined);
+
 }  // namespace agnocast::bench
